@@ -1,0 +1,113 @@
+#pragma once
+// The scene model: what a scene file describes, after validation. Units SI throughout.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace psq {
+
+/// Shell material. Plane-stress Lamé parameters are derived from E and ν where needed.
+struct Material {
+  double youngs_modulus = 1e6;  ///< E [Pa]
+  double poisson_ratio = 0.3;   ///< ν, in (-1, 0.5)
+  double density = 1000.0;      ///< ρ [kg/m³]
+  double thickness = 1e-3;      ///< h [m]
+};
+
+struct SheetGenerator {
+  double width = 1.0, height = 1.0;  ///< along x and y, centred at the origin, in the z=0 plane
+  double edge_length = 0.05;         ///< target edge length
+  struct Hole { double center_x, center_y, radius; };
+  std::vector<Hole> holes;
+  bool structured = false;           ///< regular grid (each square split in two) instead of Delaunay
+};
+struct CylinderGenerator {
+  double radius = 0.5, height = 1.0;  ///< axis along z, from z=0 to z=height, open at both ends
+  double edge_length = 0.05;
+};
+struct SphereGenerator {
+  double radius = 0.5;  ///< centred at the origin
+  double edge_length = 0.05;
+};
+
+/// Where a shell's mesh comes from: a file (OBJ, PLY, OFF) or a generator, then a rigid
+/// placement (scale, then rotation about the origin, then translation).
+struct MeshSource {
+  enum class Kind { File, Sheet, Cylinder, Sphere } kind = Kind::Sheet;
+  std::filesystem::path file;  ///< Kind::File, resolved relative to the scene file
+  SheetGenerator sheet;
+  CylinderGenerator cylinder;
+  SphereGenerator sphere;
+  double scale = 1.0;
+  Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
+  double rotation_degrees = 0.0;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+};
+
+/// Chooses vertices of one shell: inside an axis-aligned box, on a boundary loop, or listed.
+struct VertexSelector {
+  enum class Kind { Box, BoundaryLoop, List } kind = Kind::Box;
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  int boundary_loop = 0;   ///< index into the shell's boundary loops, ordered by size, largest first
+  std::vector<int> indices;
+};
+
+/// A rigid motion applied to a pinned set between two times, linearly in time: at time t the
+/// set is rotated by angle·s about the axis through `axis_point`, then translated by
+/// translation·s, with s = clamp((t − start)/(end − start), 0, 1). Motions of one set compose
+/// in order.
+struct RigidMotion {
+  double start_time = 0.0, end_time = 1.0;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitZ();
+  double angle_degrees = 0.0;
+};
+
+struct PinnedSet {
+  std::string name;
+  VertexSelector selector;
+  std::vector<RigidMotion> motions;  ///< empty: fixed in place
+};
+
+/// An external force. `Point` spreads the total force equally over the selected vertices;
+/// `Line` spreads it in proportion to each selected vertex's share of the boundary edges
+/// whose two ends are both selected.
+struct Load {
+  enum class Kind { Point, Line } kind = Kind::Point;
+  VertexSelector selector;
+  Eigen::Vector3d total_force = Eigen::Vector3d::Zero();  ///< [N]
+};
+
+struct Shell {
+  std::string name;
+  MeshSource mesh;
+  Material material;
+  std::vector<PinnedSet> pins;
+  std::vector<Load> loads;
+};
+
+struct TimeStepping {
+  double step = 0.04;  ///< pseudo time step Δt [s]
+  int frames = 25;     ///< number of steps; frame k is at time k·Δt
+};
+
+struct SolverSettings {
+  /// Converged when ‖Δx‖∞/Δt falls below this [m/s]. Unset: 1e-4 × bounding-box diagonal / s.
+  std::optional<double> tolerance;
+  int max_iterations = 200;  ///< Newton iterations per frame before reporting non-convergence
+};
+
+struct Scene {
+  std::filesystem::path source;  ///< the scene file, for messages and relative paths
+  std::string name;
+  std::vector<Shell> shells;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< [m/s²]
+  TimeStepping time;
+  SolverSettings solver;
+};
+
+}  // namespace psq

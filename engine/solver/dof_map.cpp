@@ -1,0 +1,27 @@
+#include "engine/solver/dof_map.hpp"
+
+namespace psq {
+
+DofMap::DofMap(Eigen::Index vertex_count, const std::vector<int>& pinned_vertices)
+    : reduced_(static_cast<std::size_t>(3 * vertex_count), 0) {
+  for (int v : pinned_vertices)
+    for (int c = 0; c < 3; ++c) reduced_[3 * v + c] = -1;
+  for (int& r : reduced_)
+    if (r == 0) r = static_cast<int>(free_count_++);
+}
+
+Eigen::VectorXd DofMap::restrict(const Eigen::VectorXd& full) const {
+  Eigen::VectorXd out(free_count_);
+  for (std::size_t i = 0; i < reduced_.size(); ++i)
+    if (reduced_[i] >= 0) out[reduced_[i]] = full[static_cast<Eigen::Index>(i)];
+  return out;
+}
+
+Eigen::VectorXd DofMap::extend(const Eigen::VectorXd& reduced_values) const {
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(full_size());
+  for (std::size_t i = 0; i < reduced_.size(); ++i)
+    if (reduced_[i] >= 0) out[static_cast<Eigen::Index>(i)] = reduced_values[reduced_[i]];
+  return out;
+}
+
+}  // namespace psq

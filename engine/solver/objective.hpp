@@ -1,0 +1,36 @@
+#pragma once
+// The interface every minimized energy implements: value, gradient, projected Hessian
+// blocks and a feasible step bound (the CCD-safe step once contact exists).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "engine/core/element_matrices.hpp"
+
+namespace psq {
+
+/// A PSD-projected Hessian in element form: a diagonal (mass-like terms) plus batches of
+/// dense element blocks. The sparse assembler sums them over the free degrees of freedom.
+struct HessianBlocks {
+  Eigen::VectorXd diagonal;             ///< size 3n
+  std::vector<ElementMatrices> batches; ///< reused between iterations; stencils may change
+};
+
+class Objective {
+ public:
+  virtual ~Objective() = default;
+  /// Number of unknowns (3 × vertices).
+  [[nodiscard]] virtual Eigen::Index size() const = 0;
+  virtual double value(const Eigen::VectorXd& x) = 0;
+  /// Overwrites g (resized to size()) with ∇E(x).
+  virtual void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) = 0;
+  /// Overwrites H with a positive semi-definite approximation of ∇²E(x).
+  virtual void hessian(const Eigen::VectorXd& x, HessianBlocks& H) = 0;
+  /// Largest α in (0, 1] such that x + α·dx stays feasible (intersection-free, within
+  /// strain limits). Unconstrained objectives return 1.
+  virtual double max_feasible_step(const Eigen::VectorXd& /*x*/, const Eigen::VectorXd& /*dx*/) {
+    return 1.0;
+  }
+};
+
+}  // namespace psq

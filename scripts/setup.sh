@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages PSQ needs, only those missing. Idempotent and non-interactive.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev
+  libhdf5-dev libsqlite3-dev sqlite3 libfmt-dev libtbb-dev
+  libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  gnuplot-nox
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "setup: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,14 @@
+#pragma once
+#include <filesystem>
+#include <string>
+
+namespace psq::test {
+
+std::filesystem::path source_dir();  ///< the repository root
+std::filesystem::path shared_dir();  ///< ../shared beside the repository (paper, data)
+/// A new empty directory under the build tree, unique to this test and call.
+std::filesystem::path fresh_temp_dir(const std::string& name);
+/// Writes text to a file and returns its path.
+std::filesystem::path write_file(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace psq::test
