@@ -1,5 +1,5 @@
 #pragma once
-#include "engine/scene/scene.hpp"
+#include "engine/elastic/material.hpp"
 
 namespace psq {
 

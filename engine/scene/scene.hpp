@@ -7,31 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "engine/elastic/material.hpp"
+#include "engine/mesh/generators.hpp"
+
 namespace psq {
-
-/// Shell material. Plane-stress Lamé parameters are derived from E and ν where needed.
-struct Material {
-  double youngs_modulus = 1e6;  ///< E [Pa]
-  double poisson_ratio = 0.3;   ///< ν, in (-1, 0.5)
-  double density = 1000.0;      ///< ρ [kg/m³]
-  double thickness = 1e-3;      ///< h [m]
-};
-
-struct SheetGenerator {
-  double width = 1.0, height = 1.0;  ///< along x and y, centred at the origin, in the z=0 plane
-  double edge_length = 0.05;         ///< target edge length
-  struct Hole { double center_x, center_y, radius; };
-  std::vector<Hole> holes;
-  bool structured = false;           ///< regular grid (each square split in two) instead of Delaunay
-};
-struct CylinderGenerator {
-  double radius = 0.5, height = 1.0;  ///< axis along z, from z=0 to z=height, open at both ends
-  double edge_length = 0.05;
-};
-struct SphereGenerator {
-  double radius = 0.5;  ///< centred at the origin
-  double edge_length = 0.05;
-};
 
 /// Where a shell's mesh comes from: a file (OBJ, PLY, OFF) or a generator, then a rigid
 /// placement (scale, then rotation about the origin, then translation).

@@ -1,6 +1,6 @@
 #pragma once
 #include "engine/mesh/tri_mesh.hpp"
-#include "engine/scene/scene.hpp"
+#include "engine/elastic/material.hpp"
 
 namespace psq {
 
