@@ -1,0 +1,28 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "engine/core/psd_projection.hpp"
+
+namespace psq {
+namespace {
+
+TEST(PsdProjection, ClampsNegativeEigenvaluesAndKeepsEigenvectors) {
+  // Q diag(3, -2, 1) Qᵀ with a random orthogonal Q projects to Q diag(3, 0, 1) Qᵀ.
+  const Eigen::Matrix3d q = Eigen::HouseholderQR<Eigen::Matrix3d>(Eigen::Matrix3d::Random()).householderQ();
+  Eigen::MatrixXd m = q * Eigen::Vector3d(3, -2, 1).asDiagonal() * q.transpose();
+  project_to_psd(m);
+  const Eigen::Matrix3d expected = q * Eigen::Vector3d(3, 0, 1).asDiagonal() * q.transpose();
+  EXPECT_LT((m - expected).norm(), 1e-12);
+}
+
+TEST(PsdProjection, LeavesPositiveSemiDefiniteMatricesUnchanged) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(6, 4);
+  Eigen::MatrixXd m = a * a.transpose();
+  const Eigen::MatrixXd before = m;
+  project_to_psd(m);
+  EXPECT_EQ(m, before);
+}
+
+}  // namespace
+}  // namespace psq
