@@ -17,7 +17,7 @@ TEST(PsdProjection, ClampsNegativeEigenvaluesAndKeepsEigenvectors) {
 }
 
 TEST(PsdProjection, LeavesPositiveSemiDefiniteMatricesUnchanged) {
-  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(6, 4);
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(6, 10);
   Eigen::MatrixXd m = a * a.transpose();
   const Eigen::MatrixXd before = m;
   project_to_psd(m);
