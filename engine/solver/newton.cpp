@@ -1,0 +1,205 @@
+#include "engine/solver/newton.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace psq {
+namespace {
+
+/// Diagonal shifts tried when K is not positive definite: σ = 1e-8·s, 1e-7·s, …, 1·s with s
+/// the mean diagonal of K, so the first shift barely perturbs a well-scaled system and the
+/// last one turns d into a scaled gradient step.
+constexpr double kFirstRelativeShift = 1e-8;
+constexpr double kShiftGrowth = 10.0;
+constexpr int kShiftAttempts = 9;
+
+/// Energy changes smaller than this fraction of |E| are below the rounding of E itself, so
+/// the Armijo test does not reject a step for them (it would stall a converging solve).
+constexpr double kEnergyRoundoff = 1e-12;
+
+void check_settings(const NewtonSettings& s) {
+  const auto require = [](bool ok, const char* name, double value, const char* range) {
+    if (!ok)
+      throw InputError(fmt::format("Newton setting {} = {} is out of range: it must be {}", name,
+                                   value, range));
+  };
+  require(s.tolerance > 0.0 && std::isfinite(s.tolerance), "tolerance", s.tolerance, "> 0");
+  require(s.step_scale > 0.0 && std::isfinite(s.step_scale), "step_scale", s.step_scale, "> 0");
+  require(s.max_iterations >= 0, "max_iterations", s.max_iterations, ">= 0");
+  require(s.armijo >= 0.0 && s.armijo < 1.0, "armijo", s.armijo, "in [0, 1)");
+  require(s.backtracking > 0.0 && s.backtracking < 1.0, "backtracking", s.backtracking,
+          "in (0, 1)");
+  require(s.min_step > 0.0 && s.min_step <= 1.0, "min_step", s.min_step, "in (0, 1]");
+}
+
+std::string dof_name(Eigen::Index dof) {
+  return fmt::format("DOF {} (vertex {}, {})", dof, dof / 3, "xyz"[dof % 3]);
+}
+
+std::string where(int iteration) {
+  return iteration == 0 ? std::string("at the initial point")
+                        : fmt::format("at Newton iteration {}", iteration);
+}
+
+/// Fixed DOFs are ignored: their gradient entries never enter the system.
+void check_gradient(const Eigen::VectorXd& gradient, const DofMap& dofs, int iteration) {
+  for (Eigen::Index i = 0; i < gradient.size(); ++i)
+    if (dofs.reduced(i) >= 0 && !std::isfinite(gradient[i]))
+      throw NumericalError(fmt::format("gradient is {} at {} {}", gradient[i], dof_name(i),
+                                       where(iteration)));
+}
+
+/// Mean |K_cc| of an upper-triangular CSC matrix (the diagonal closes each column), or 1 when
+/// that is zero or not finite, so the shift has a scale even for a zero matrix.
+double diagonal_scale(const Eigen::SparseMatrix<double>& upper) {
+  if (upper.cols() == 0) return 1.0;
+  double sum = 0.0;
+  for (Eigen::Index c = 0; c < upper.cols(); ++c)
+    sum += std::abs(upper.valuePtr()[upper.outerIndexPtr()[c + 1] - 1]);
+  const double mean = sum / static_cast<double>(upper.cols());
+  return mean > 0.0 && std::isfinite(mean) ? mean : 1.0;
+}
+
+}  // namespace
+
+NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, const DofMap& dofs,
+                                    const NewtonSettings& settings, const Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  check_settings(settings);
+  if (objective.size() != x.size() || dofs.full_size() != x.size())
+    throw std::invalid_argument(fmt::format("Newton: objective has {} unknowns, x {}, DofMap {}",
+                                            objective.size(), x.size(), dofs.full_size()));
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x[i]))
+      throw NumericalError(fmt::format("initial position is {} at {}", x[i], dof_name(i)));
+
+  NewtonResult result;
+  NewtonIteration record;
+  double energy = 0.0;
+  {
+    ScopedTimer timer(record.times.assembly);
+    energy = objective.value(x);
+  }
+  if (!std::isfinite(energy))
+    throw NumericalError(fmt::format("objective value is {} at the initial point", energy));
+
+  Eigen::VectorXd gradient;
+  Eigen::VectorXd free_gradient;
+  for (int k = 0;; ++k) {
+    record.iteration = k;
+    record.energy = energy;
+    {
+      ScopedTimer timer(record.times.assembly);
+      objective.gradient(x, gradient);
+      check_gradient(gradient, dofs, k);
+      free_gradient = dofs.restrict(gradient);
+    }
+    record.gradient_norm = free_gradient.norm();
+    const Eigen::VectorXd free_direction =
+        search_direction(objective, x, dofs, free_gradient, record);
+    const Eigen::VectorXd direction = dofs.extend(free_direction);
+    record.step_norm = direction.lpNorm<Eigen::Infinity>() / settings.step_scale;
+
+    // A gradient fallback step says nothing about the distance to the minimum.
+    result.converged =
+        record.direction != DirectionKind::gradient && record.step_norm < settings.tolerance;
+    if (!result.converged && k < settings.max_iterations)
+      energy = line_search(objective, x, direction, energy, free_gradient.dot(free_direction),
+                           settings, record);
+
+    result.history.push_back(record);
+    result.times += record.times;
+    if (progress) progress(record);
+    if (result.converged || k == settings.max_iterations) break;
+    record = NewtonIteration{};
+  }
+
+  const NewtonIteration& last = result.history.back();
+  result.iterations = last.iteration;
+  result.energy = last.energy;
+  result.gradient_norm = last.gradient_norm;
+  result.step_norm = last.step_norm;
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen::VectorXd& x,
+                                               const DofMap& dofs,
+                                               const Eigen::VectorXd& free_gradient,
+                                               NewtonIteration& record) {
+  // A stationary point (or nothing free to move): d = 0 exactly, no system to solve.
+  if (free_gradient.isZero(0.0)) return Eigen::VectorXd::Zero(free_gradient.size());
+  {
+    ScopedTimer timer(record.times.assembly);
+    objective.hessian(x, hessian_);
+    record.pattern_changed = assembler_.assemble(hessian_, dofs);
+  }
+  if (record.pattern_changed || !cholmod_.analyzed()) {
+    ScopedTimer timer(record.times.factorization);
+    cholmod_.analyze(assembler_.matrix());
+  }
+
+  Eigen::VectorXd direction;
+  record.direction = DirectionKind::newton;
+  if (try_newton(0.0, free_gradient, direction, record)) return direction;
+
+  record.direction = DirectionKind::shifted_newton;
+  double shift = kFirstRelativeShift * diagonal_scale(assembler_.matrix());
+  for (int attempt = 0; attempt < kShiftAttempts; ++attempt, shift *= kShiftGrowth) {
+    record.shift = shift;
+    if (try_newton(shift, free_gradient, direction, record)) return direction;
+  }
+  record.direction = DirectionKind::gradient;
+  record.shift = 0.0;
+  return -free_gradient;
+}
+
+bool NewtonSolver::try_newton(double shift, const Eigen::VectorXd& free_gradient,
+                              Eigen::VectorXd& direction, NewtonIteration& record) {
+  try {
+    ScopedTimer timer(record.times.factorization);
+    cholmod_.factorize(assembler_.matrix(), shift);
+  } catch (const NotPositiveDefiniteError&) {
+    return false;
+  } catch (const NumericalError& error) {
+    throw NumericalError(fmt::format("Hessian {}: {}", where(record.iteration), error.what()));
+  }
+  ScopedTimer timer(record.times.solve);
+  direction = cholmod_.solve(-free_gradient);
+  return direction.allFinite() && free_gradient.dot(direction) < 0.0;
+}
+
+double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
+                                 const Eigen::VectorXd& direction, double energy, double slope,
+                                 const NewtonSettings& settings, NewtonIteration& record) {
+  ScopedTimer timer(record.times.line_search);
+  const double feasible = objective.max_feasible_step(x, direction);
+  if (std::isnan(feasible))
+    throw NumericalError(fmt::format("max_feasible_step is nan {}", where(record.iteration)));
+  record.feasible_step = std::min(1.0, feasible);
+
+  const double slack = kEnergyRoundoff * std::abs(energy);
+  for (double alpha = record.feasible_step; alpha >= settings.min_step;
+       alpha *= settings.backtracking) {
+    trial_ = x + alpha * direction;
+    const double trial_energy = objective.value(trial_);
+    ++record.line_search_trials;
+    const double bound = energy + settings.armijo * alpha * slope + slack;
+    if (std::isfinite(trial_energy) && trial_energy <= bound) {
+      x.swap(trial_);
+      record.step_length = alpha;
+      return trial_energy;
+    }
+  }
+  throw NumericalError(fmt::format(
+      "line search failed at iteration {}, ‖g‖ = {:.6e} (first trial step {:.3e}, {} trials, "
+      "E = {:.12e})",
+      record.iteration, record.gradient_norm, record.feasible_step, record.line_search_trials,
+      energy));
+}
+
+}  // namespace psq

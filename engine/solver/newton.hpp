@@ -1,0 +1,68 @@
+#pragma once
+// Projected Newton with a backtracking line search (DESIGN.md §4), the minimizer of every
+// incremental potential. A NewtonSolver keeps the sparse pattern, scatter map and CHOLMOD
+// analysis between calls, because quasistatic stepping calls it every frame with the same
+// stencils.
+
+#include <functional>
+
+#include "engine/solver/cholmod_solver.hpp"
+#include "engine/solver/dof_map.hpp"
+#include "engine/solver/objective.hpp"
+#include "engine/solver/solver_stats.hpp"
+#include "engine/solver/sparse_assembler.hpp"
+
+namespace psq {
+
+struct NewtonSettings {
+  /// Converged when ‖d‖∞ / step_scale < tolerance for the full Newton step d (IPC's test: a
+  /// velocity-like measure when step_scale = Δt).
+  double tolerance = 1e-5;
+  double step_scale = 1.0;  ///< Δt of the incremental potential, set by the caller
+  int max_iterations = 100; ///< Newton steps before giving up (result.converged = false)
+  double armijo = 1e-4;     ///< c in E(x + αd) ≤ E(x) + c·α·gᵀd
+  double backtracking = 0.5; ///< α ← backtracking·α after a rejected trial
+  double min_step = 1e-12;  ///< the line search fails once α drops below this (≈ 40 halvings)
+};
+
+/// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected
+/// Hessian blocks, sparse assembly, Cholesky, direction d = −K⁻¹g (with a diagonal shift, then
+/// the negative gradient, as fallbacks when K is not positive definite or d is not a descent
+/// direction), first trial step α = min(1, max_feasible_step(x, d)), Armijo backtracking.
+class NewtonSolver {
+ public:
+  using Progress = std::function<void(const NewtonIteration&)>;
+
+  /// Minimizes `objective` starting from x (size 3n), overwriting x with the last accepted
+  /// iterate. Fixed DOFs of `dofs` keep their values exactly. `progress` is called once per
+  /// record appended to the history.
+  /// @throws NumericalError when x, E(x) or ∇E(x) is not finite at the start (naming which),
+  ///   when the gradient or Hessian becomes non-finite, or when the line search cannot
+  ///   decrease E above min_step.
+  /// @throws InputError when a setting is out of range (naming it).
+  NewtonResult minimize(Objective& objective, Eigen::VectorXd& x, const DofMap& dofs,
+                        const NewtonSettings& settings, const Progress& progress = {});
+
+ private:
+  /// Hessian, assembly, factorization and solve, with the fallbacks; returns d over the free
+  /// DOFs and records how it was obtained.
+  Eigen::VectorXd search_direction(Objective& objective, const Eigen::VectorXd& x,
+                                   const DofMap& dofs, const Eigen::VectorXd& free_gradient,
+                                   NewtonIteration& record);
+  /// Factorizes K + shift·I and solves for d; false when that matrix is not positive definite
+  /// or d is not a descent direction (gᵀd ≥ 0).
+  bool try_newton(double shift, const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
+                  NewtonIteration& record);
+  /// Backtracking Armijo line search from α = min(1, max_feasible_step); moves x to the
+  /// accepted point and returns its energy.
+  double line_search(Objective& objective, Eigen::VectorXd& x, const Eigen::VectorXd& direction,
+                     double energy, double slope, const NewtonSettings& settings,
+                     NewtonIteration& record);
+
+  HessianBlocks hessian_;
+  SparseAssembler assembler_;
+  CholmodSolver cholmod_;
+  Eigen::VectorXd trial_;
+};
+
+}  // namespace psq

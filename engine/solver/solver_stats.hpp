@@ -1,0 +1,79 @@
+#pragma once
+// What a Newton solve reports: one record per iteration and totals, so callers can plot
+// convergence and see where the time goes. The engine never prints; callers display these.
+
+#include <chrono>
+#include <vector>
+
+namespace psq {
+
+/// Wall-clock seconds spent in each phase of a Newton iteration.
+struct PhaseTimes {
+  /// Objective gradient and Hessian blocks (and the initial value) plus the scatter.
+  double assembly = 0.0;
+  double factorization = 0.0;  ///< CHOLMOD symbolic analysis (when the pattern changed) + numeric
+  double solve = 0.0;          ///< triangular solves for the search direction
+  double line_search = 0.0;    ///< feasible-step query and every objective value in the line search
+
+  [[nodiscard]] double total() const { return assembly + factorization + solve + line_search; }
+  PhaseTimes& operator+=(const PhaseTimes& other) {
+    assembly += other.assembly;
+    factorization += other.factorization;
+    solve += other.solve;
+    line_search += other.line_search;
+    return *this;
+  }
+};
+
+/// How the search direction of an iteration was obtained.
+enum class DirectionKind {
+  newton,          ///< d = −K⁻¹g with the projected Hessian K
+  shifted_newton,  ///< d = −(K + σI)⁻¹g: K was not positive definite or d was not descent
+  gradient,        ///< d = −g: every shift failed too
+};
+
+/// One Newton iteration. The last record of a solve is the convergence check: it carries the
+/// final energy, gradient norm and step norm, and takes no step (step_length = 0).
+struct NewtonIteration {
+  int iteration = 0;
+  double energy = 0.0;             ///< E(x) at the start of the iteration
+  double gradient_norm = 0.0;      ///< ‖∇E(x)‖₂ over the free DOFs
+  double step_norm = 0.0;          ///< ‖d‖∞ / step_scale for the full direction d
+  double step_length = 0.0;        ///< accepted α (0 when no step was taken)
+  double feasible_step = 0.0;      ///< first trial α = min(1, max_feasible_step(x, d))
+  int line_search_trials = 0;      ///< objective values evaluated by the line search
+  DirectionKind direction = DirectionKind::newton;
+  double shift = 0.0;              ///< σ when direction == shifted_newton
+  bool pattern_changed = false;    ///< the sparsity pattern changed, so it was re-analyzed
+  PhaseTimes times;
+};
+
+/// Outcome of NewtonSolver::minimize. `converged == false` means max_iterations steps were
+/// taken without meeting the tolerance; the caller decides what that means.
+struct NewtonResult {
+  bool converged = false;
+  int iterations = 0;          ///< steps taken (history.size() − 1)
+  double energy = 0.0;         ///< final E(x)
+  double gradient_norm = 0.0;  ///< final ‖∇E(x)‖₂ over the free DOFs
+  double step_norm = 0.0;      ///< final ‖d‖∞ / step_scale
+  PhaseTimes times;            ///< sum of the per-iteration times
+  double wall_seconds = 0.0;   ///< the whole call, ≥ times.total()
+  std::vector<NewtonIteration> history;
+};
+
+/// Adds the seconds between construction and destruction to `sink`.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double& sink) : sink_(sink), start_(std::chrono::steady_clock::now()) {}
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+  ~ScopedTimer() {
+    sink_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  double& sink_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace psq

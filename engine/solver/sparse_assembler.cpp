@@ -1,0 +1,228 @@
+#include "engine/solver/sparse_assembler.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+#include <stdexcept>
+
+namespace psq {
+namespace {
+
+/// Rejects blocks whose sizes disagree with each other or with the DOF map: a bug upstream,
+/// and cheap to catch here before it turns into out-of-bounds reads.
+void check_sizes(const HessianBlocks& blocks, const DofMap& dofs) {
+  if (blocks.diagonal.size() != 0 && blocks.diagonal.size() != dofs.full_size())
+    throw std::invalid_argument(fmt::format("Hessian diagonal has {} entries, expected {}",
+                                            blocks.diagonal.size(), dofs.full_size()));
+  for (std::size_t b = 0; b < blocks.batches.size(); ++b) {
+    const ElementMatrices& batch = blocks.batches[b];
+    const bool stencil_ok = batch.stencil_size > 0 ? batch.vertices.size() % batch.stencil_size == 0
+                                                   : batch.vertices.empty();
+    if (!stencil_ok || batch.values.size() != batch.element_count() * batch.block_size())
+      throw std::invalid_argument(fmt::format(
+          "Hessian batch {}: stencil size {}, {} vertices and {} values do not match", b,
+          batch.stencil_size, batch.vertices.size(), batch.values.size()));
+  }
+}
+
+/// Slot of entry (row, col) in a compressed-column pattern whose columns hold sorted rows.
+int find_slot(const Eigen::SparseMatrix<double>& pattern, int row, int col) {
+  const int* inner = pattern.innerIndexPtr();
+  const int* first = inner + pattern.outerIndexPtr()[col];
+  const int* last = inner + pattern.outerIndexPtr()[col + 1];
+  return static_cast<int>(std::lower_bound(first, last, row) - inner);
+}
+
+bool has_free_dof(const DofMap& dofs, int vertex) {
+  return dofs.reduced(3 * vertex) >= 0 || dofs.reduced(3 * vertex + 1) >= 0 ||
+         dofs.reduced(3 * vertex + 2) >= 0;
+}
+
+/// Vertex-level upper adjacency: for each vertex, the sorted vertices ≤ it that share an
+/// element with it (itself included). Built at vertex granularity because it is 9× smaller
+/// than the DOF-level pattern it expands to.
+struct VertexAdjacency {
+  std::vector<int> start;  ///< size vertex_count + 1
+  std::vector<int> rows;
+};
+
+VertexAdjacency upper_vertex_adjacency(const HessianBlocks& blocks, const DofMap& dofs) {
+  const int vertex_count = static_cast<int>(dofs.full_size() / 3);
+  std::vector<char> active(vertex_count);
+  for (int v = 0; v < vertex_count; ++v) active[v] = has_free_dof(dofs, v);
+
+  // Two passes over the element pairs: count per column vertex, then fill.
+  std::vector<int> count(vertex_count + 1, 0);
+  const auto for_each_pair = [&](auto&& visit) {
+    for (const ElementMatrices& batch : blocks.batches) {
+      const int s = batch.stencil_size;
+      for (std::size_t e = 0; e < batch.element_count(); ++e) {
+        const int* stencil = batch.vertices.data() + e * s;
+        for (int a = 0; a < s; ++a)
+          for (int b = a + 1; b < s; ++b) {
+            const int va = stencil[a];
+            const int vb = stencil[b];
+            if (active[va] && active[vb]) visit(std::min(va, vb), std::max(va, vb));
+          }
+      }
+    }
+  };
+  for (int v = 0; v < vertex_count; ++v) count[v] = active[v];
+  for_each_pair([&](int, int col) { ++count[col]; });
+
+  VertexAdjacency adjacency;
+  adjacency.start.assign(vertex_count + 1, 0);
+  for (int v = 0; v < vertex_count; ++v) adjacency.start[v + 1] = adjacency.start[v] + count[v];
+  adjacency.rows.resize(adjacency.start[vertex_count]);
+  std::vector<int> cursor(adjacency.start.begin(), adjacency.start.end() - 1);
+  for (int v = 0; v < vertex_count; ++v)
+    if (active[v]) adjacency.rows[cursor[v]++] = v;
+  for_each_pair([&](int row, int col) { adjacency.rows[cursor[col]++] = row; });
+
+  // Sort and deduplicate each column in place, compacting the array.
+  int write = 0;
+  for (int v = 0; v < vertex_count; ++v) {
+    const auto first = adjacency.rows.begin() + adjacency.start[v];
+    const auto last = adjacency.rows.begin() + adjacency.start[v + 1];
+    std::sort(first, last);
+    const auto unique_end = std::unique(first, last);
+    adjacency.start[v] = write;
+    write = static_cast<int>(std::copy(first, unique_end, adjacency.rows.begin() + write) -
+                             adjacency.rows.begin());
+  }
+  adjacency.start[vertex_count] = write;
+  adjacency.rows.resize(write);
+  return adjacency;
+}
+
+}  // namespace
+
+bool SparseAssembler::assemble(const HessianBlocks& blocks, const DofMap& dofs) {
+  check_sizes(blocks, dofs);
+  bool pattern_changed = false;
+  if (rebuild_count_ == 0 || !stencils_match(blocks, dofs)) {
+    pattern_changed = rebuild_pattern(blocks, dofs) || rebuild_count_ == 0;
+    rebuild_scatter_map(blocks, dofs);
+    ++rebuild_count_;
+  }
+  scatter(blocks);
+  return pattern_changed;
+}
+
+bool SparseAssembler::stencils_match(const HessianBlocks& blocks, const DofMap& dofs) const {
+  if (static_cast<Eigen::Index>(reduced_.size()) != dofs.full_size()) return false;
+  for (std::size_t i = 0; i < reduced_.size(); ++i)
+    if (reduced_[i] != dofs.reduced(static_cast<Eigen::Index>(i))) return false;
+  if (blocks.batches.size() != batches_.size()) return false;
+  for (std::size_t b = 0; b < batches_.size(); ++b)
+    if (blocks.batches[b].stencil_size != batches_[b].stencil_size ||
+        blocks.batches[b].vertices != batches_[b].vertices)
+      return false;
+  return true;
+}
+
+bool SparseAssembler::rebuild_pattern(const HessianBlocks& blocks, const DofMap& dofs) {
+  const Eigen::Index vertex_count = dofs.full_size() / 3;
+  for (std::size_t b = 0; b < blocks.batches.size(); ++b)
+    for (int v : blocks.batches[b].vertices)
+      if (v < 0 || v >= vertex_count)
+        throw std::invalid_argument(fmt::format(
+            "Hessian batch {} names vertex {}, outside [0, {})", b, v, vertex_count));
+
+  const VertexAdjacency adjacency = upper_vertex_adjacency(blocks, dofs);
+  const auto free_size = static_cast<int>(dofs.free_size());
+  std::vector<int> outer(free_size + 1, 0);
+  std::vector<int> inner;
+  inner.reserve(adjacency.rows.size() * 9);
+  int column = 0;
+  for (Eigen::Index v = 0; v < vertex_count; ++v)
+    for (int c = 0; c < 3; ++c) {
+      const int col = dofs.reduced(3 * v + c);
+      if (col < 0) continue;
+      // Columns are emitted in full-DOF order, which must be their reduced order.
+      if (col != column)
+        throw std::invalid_argument("DofMap must number free DOFs in increasing order");
+      outer[column++] = static_cast<int>(inner.size());
+      for (int k = adjacency.start[v]; k < adjacency.start[v + 1]; ++k)
+        for (int d = 0; d < 3; ++d) {
+          const int row = dofs.reduced(3 * adjacency.rows[k] + d);
+          if (row >= 0 && row <= col) inner.push_back(row);
+        }
+    }
+  outer[free_size] = static_cast<int>(inner.size());
+
+  const bool same = matrix_.rows() == free_size && matrix_.nonZeros() == outer[free_size] &&
+                    std::equal(outer.begin(), outer.end(), matrix_.outerIndexPtr()) &&
+                    std::equal(inner.begin(), inner.end(), matrix_.innerIndexPtr());
+  if (same) return false;
+  matrix_.resize(free_size, free_size);
+  matrix_.resizeNonZeros(outer[free_size]);
+  std::copy(outer.begin(), outer.end(), matrix_.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), matrix_.innerIndexPtr());
+  return true;
+}
+
+void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs) {
+  reduced_.resize(static_cast<std::size_t>(dofs.full_size()));
+  diagonal_slots_.resize(reduced_.size());
+  for (std::size_t i = 0; i < reduced_.size(); ++i) {
+    const int r = dofs.reduced(static_cast<Eigen::Index>(i));
+    reduced_[i] = r;
+    diagonal_slots_[i] = r < 0 ? -1 : find_slot(matrix_, r, r);
+  }
+
+  batches_.resize(blocks.batches.size());
+  for (std::size_t b = 0; b < batches_.size(); ++b) {
+    const ElementMatrices& batch = blocks.batches[b];
+    BatchMap& map = batches_[b];
+    map.stencil_size = batch.stencil_size;
+    map.vertices = batch.vertices;
+    map.mirrored.clear();
+    const int m = batch.dofs_per_element();
+    const std::size_t upper_size = static_cast<std::size_t>(m) * (m + 1) / 2;
+    map.slots.resize(batch.element_count() * upper_size);
+    std::vector<int> local(m);
+    int* slot = map.slots.data();
+    for (std::size_t e = 0; e < batch.element_count(); ++e) {
+      for (int k = 0; k < m; ++k)
+        local[k] = reduced_[3 * batch.vertices[e * batch.stencil_size + k / 3] + k % 3];
+      for (int j = 0; j < m; ++j)
+        for (int i = 0; i <= j; ++i) {
+          const int ri = local[i];
+          const int rj = local[j];
+          *slot = (ri < 0 || rj < 0) ? -1
+                                     : find_slot(matrix_, std::min(ri, rj), std::max(ri, rj));
+          if (i < j && ri == rj && ri >= 0) {
+            const std::size_t mirror = e * batch.block_size() + static_cast<std::size_t>(i) * m + j;
+            map.mirrored.emplace_back(mirror, *slot);
+          }
+          ++slot;
+        }
+    }
+  }
+}
+
+void SparseAssembler::scatter(const HessianBlocks& blocks) {
+  double* values = matrix_.valuePtr();
+  std::fill(values, values + matrix_.nonZeros(), 0.0);
+  if (blocks.diagonal.size() != 0)
+    for (std::size_t i = 0; i < diagonal_slots_.size(); ++i)
+      if (diagonal_slots_[i] >= 0)
+        values[diagonal_slots_[i]] += blocks.diagonal[static_cast<Eigen::Index>(i)];
+
+  for (std::size_t b = 0; b < batches_.size(); ++b) {
+    const ElementMatrices& batch = blocks.batches[b];
+    const BatchMap& map = batches_[b];
+    const int m = batch.dofs_per_element();
+    const int* slot = map.slots.data();
+    const double* block = batch.values.data();
+    for (std::size_t e = 0; e < batch.element_count(); ++e, block += batch.block_size())
+      for (int j = 0; j < m; ++j) {
+        const double* column = block + static_cast<std::ptrdiff_t>(j) * m;
+        for (int i = 0; i <= j; ++i, ++slot)
+          if (*slot >= 0) values[*slot] += column[i];
+      }
+    for (const auto& [index, target] : map.mirrored) values[target] += batch.values[index];
+  }
+}
+
+}  // namespace psq

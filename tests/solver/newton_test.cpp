@@ -1,0 +1,527 @@
+#include "engine/solver/newton.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "engine/core/psd_projection.hpp"
+#include "support/finite_difference.hpp"
+
+namespace psq {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The message of the NumericalError thrown by f, or "" when none is thrown.
+template <class F>
+std::string numerical_error_message(F&& f) {
+  try {
+    f();
+  } catch (const NumericalError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// E = ½ Σᵢ aᵢ (xᵢ − bᵢ)² + ½ Σ_springs k |x_p − x_q|²: a quadratic with a diagonal and
+/// coupling element blocks, minimized by one exact Newton step.
+class Quadratic : public Objective {
+ public:
+  Quadratic(Eigen::VectorXd a, Eigen::VectorXd b, std::vector<int> springs, double k)
+      : a_(std::move(a)), b_(std::move(b)), springs_(std::move(springs)), k_(k) {}
+
+  [[nodiscard]] Eigen::Index size() const override { return a_.size(); }
+  double value(const Eigen::VectorXd& x) override {
+    double e = 0.5 * (a_.array() * (x - b_).array().square()).sum();
+    for (std::size_t s = 0; s < springs_.size(); s += 2) {
+      const Eigen::Vector3d d = x.segment<3>(3 * springs_[s]) - x.segment<3>(3 * springs_[s + 1]);
+      e += 0.5 * k_ * d.squaredNorm();
+    }
+    return e;
+  }
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+    g = a_.cwiseProduct(x - b_);
+    for (std::size_t s = 0; s < springs_.size(); s += 2) {
+      const Eigen::Vector3d f =
+          k_ * (x.segment<3>(3 * springs_[s]) - x.segment<3>(3 * springs_[s + 1]));
+      g.segment<3>(3 * springs_[s]) += f;
+      g.segment<3>(3 * springs_[s + 1]) -= f;
+    }
+  }
+  void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+    h.diagonal = a_;
+    h.batches.resize(1);
+    h.batches[0].reset(2, springs_);
+    for (std::size_t e = 0; e < h.batches[0].element_count(); ++e) {
+      auto block = h.batches[0].block(e);
+      const Eigen::Matrix3d i3 = k_ * Eigen::Matrix3d::Identity();
+      block << i3, -i3, -i3, i3;
+    }
+  }
+  /// The same quadratic as a dense matrix: E = ½ xᵀQx − cᵀx + const.
+  [[nodiscard]] Eigen::MatrixXd dense_matrix() const {
+    Eigen::MatrixXd q = a_.asDiagonal();
+    for (std::size_t s = 0; s < springs_.size(); s += 2)
+      for (int c = 0; c < 3; ++c) {
+        const int p = 3 * springs_[s] + c;
+        const int r = 3 * springs_[s + 1] + c;
+        q(p, p) += k_;
+        q(r, r) += k_;
+        q(p, r) -= k_;
+        q(r, p) -= k_;
+      }
+    return q;
+  }
+  [[nodiscard]] Eigen::VectorXd linear_term() const { return a_.cwiseProduct(b_); }
+
+ private:
+  Eigen::VectorXd a_, b_;
+  std::vector<int> springs_;
+  double k_;
+};
+
+/// A chain of springs with rest length L, E = Σ k/2 (|x_{i+1} − x_i| − L)², with per-element
+/// PSD-projected Hessians. Records whether any evaluation saw the pinned ends moved.
+class SpringChain : public Objective {
+ public:
+  SpringChain(int vertex_count, double rest_length, double stiffness, Eigen::VectorXd state)
+      : n_(vertex_count), rest_(rest_length), k_(stiffness), pinned_state_(std::move(state)) {
+    for (int i = 0; i + 1 < n_; ++i) {
+      edges_.push_back(i);
+      edges_.push_back(i + 1);
+    }
+  }
+
+  [[nodiscard]] Eigen::Index size() const override { return 3 * n_; }
+  double value(const Eigen::VectorXd& x) override {
+    check_pins(x);
+    double e = 0.0;
+    for (int i = 0; i + 1 < n_; ++i) {
+      const double stretch = (x.segment<3>(3 * i + 3) - x.segment<3>(3 * i)).norm() - rest_;
+      e += 0.5 * k_ * stretch * stretch;
+    }
+    return e;
+  }
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+    check_pins(x);
+    g = Eigen::VectorXd::Zero(3 * n_);
+    for (int i = 0; i + 1 < n_; ++i) {
+      const Eigen::Vector3d d = x.segment<3>(3 * i + 3) - x.segment<3>(3 * i);
+      const Eigen::Vector3d f = k_ * (d.norm() - rest_) * d.normalized();
+      g.segment<3>(3 * i + 3) += f;
+      g.segment<3>(3 * i) -= f;
+    }
+  }
+  void hessian(const Eigen::VectorXd& x, HessianBlocks& h) override {
+    check_pins(x);
+    h.diagonal.resize(0);
+    h.batches.resize(1);
+    h.batches[0].reset(2, edges_);
+    for (int i = 0; i + 1 < n_; ++i) {
+      const Eigen::Vector3d d = x.segment<3>(3 * i + 3) - x.segment<3>(3 * i);
+      const double length = d.norm();
+      const Eigen::Vector3d u = d / length;
+      // ∂²E/∂d² = k [uuᵀ + (1 − L/l)(I − uuᵀ)], indefinite for compressed springs.
+      const Eigen::Matrix3d along = u * u.transpose();
+      const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - along;
+      const Eigen::Matrix3d hd = k_ * (along + (1.0 - rest_ / length) * across);
+      auto block = h.batches[0].block(i);
+      block << hd, -hd, -hd, hd;
+      project_to_psd(block);
+    }
+  }
+
+  bool pins_moved = false;
+
+ private:
+  void check_pins(const Eigen::VectorXd& x) {
+    for (int c = 0; c < 3; ++c)
+      pins_moved = pins_moved || x[c] != pinned_state_[c] ||
+                   x[3 * (n_ - 1) + c] != pinned_state_[3 * (n_ - 1) + c];
+  }
+
+  int n_;
+  double rest_;
+  double k_;
+  Eigen::VectorXd pinned_state_;
+  std::vector<int> edges_;
+};
+
+/// ½ Σ (xᵢ − target)² with an optional nan region and feasible-step bound, for line search
+/// tests. Records every point at which the gradient was evaluated (the accepted iterates).
+class ProbeQuadratic : public Objective {
+ public:
+  explicit ProbeQuadratic(Eigen::Index size, double target) : size_(size), target_(target) {}
+
+  [[nodiscard]] Eigen::Index size() const override { return size_; }
+  double value(const Eigen::VectorXd& x) override {
+    if (!iterates.empty() && (x - iterates.back()).lpNorm<Eigen::Infinity>() > nan_radius)
+      return kNaN;
+    return 0.5 * (x.array() - target_).square().sum();
+  }
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+    iterates.push_back(x);
+    g = (x.array() - target_).matrix();
+  }
+  void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+    h.diagonal = Eigen::VectorXd::Constant(size_, hessian_diagonal);
+    h.batches.clear();
+  }
+  double max_feasible_step(const Eigen::VectorXd&, const Eigen::VectorXd& dx) override {
+    return std::min(1.0, max_displacement / dx.lpNorm<Eigen::Infinity>());
+  }
+
+  double nan_radius = std::numeric_limits<double>::infinity();
+  double max_displacement = std::numeric_limits<double>::infinity();
+  double hessian_diagonal = 1.0;
+  std::vector<Eigen::VectorXd> iterates;
+
+ private:
+  Eigen::Index size_;
+  double target_;
+};
+
+NewtonSettings tight_settings() {
+  NewtonSettings settings;
+  settings.tolerance = 1e-10;
+  settings.max_iterations = 60;
+  return settings;
+}
+
+TEST(Newton, QuadraticConvergesInOneStep) {
+  const int vertices = 6;
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> positive(0.5, 3.0);
+  const auto random = [&](double offset) -> Eigen::VectorXd {
+    return Eigen::VectorXd::NullaryExpr(3 * vertices, [&] { return positive(rng) + offset; });
+  };
+  const Eigen::VectorXd a = random(0.0);
+  const Eigen::VectorXd b = random(-1.7);
+  Quadratic quadratic(a, b, {0, 1, 1, 2, 2, 3, 3, 4, 1, 4, 4, 5}, 2.0);
+  const DofMap dofs(vertices, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3 * vertices);
+
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(quadratic, x, dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_EQ(result.iterations, 1);
+  ASSERT_EQ(result.history.size(), 2u);
+  EXPECT_EQ(result.history[0].step_length, 1.0);
+  EXPECT_EQ(result.history[0].direction, DirectionKind::newton);
+  const Eigen::VectorXd exact = quadratic.dense_matrix().ldlt().solve(quadratic.linear_term());
+  EXPECT_LT((x - exact).lpNorm<Eigen::Infinity>(), 1e-12);
+}
+
+TEST(Newton, SeparableQuadraticWithPinnedVertex) {
+  const Eigen::VectorXd a = Eigen::VectorXd::LinSpaced(9, 1.0, 5.0);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(9, -2.0, 2.0);
+  Quadratic quadratic(a, b, {}, 0.0);
+  const DofMap dofs(3, {1});
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(9, 0.25);
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(quadratic, x, dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_EQ(result.iterations, 1);
+  for (int i = 0; i < 9; ++i) {
+    if (i >= 3 && i < 6)
+      EXPECT_EQ(x[i], 0.25) << "pinned DOF " << i << " moved";
+    else
+      EXPECT_NEAR(x[i], b[i], 1e-14);
+  }
+}
+
+/// A stretched chain between two pins, started from a crooked state.
+struct ChainProblem {
+  static constexpr int kVertices = 12;
+  Eigen::Vector3d start{0.3, -0.2, 0.1};
+  Eigen::Vector3d end;
+  Eigen::VectorXd x;
+  DofMap dofs{kVertices, {0, kVertices - 1}};
+
+  ChainProblem() {
+    const double rest = 1.0;
+    end = start + 1.5 * rest * (kVertices - 1) * Eigen::Vector3d(2, 1, -2).normalized();
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+    x.resize(3 * kVertices);
+    for (int i = 0; i < kVertices; ++i) {
+      x.segment<3>(3 * i) = even_point(i);
+      if (i != 0 && i != kVertices - 1)
+        x.segment<3>(3 * i) += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+    }
+  }
+  [[nodiscard]] Eigen::Vector3d even_point(int i) const {
+    return start + (end - start) * (static_cast<double>(i) / (kVertices - 1));
+  }
+  SpringChain objective() const { return SpringChain(kVertices, 1.0, 10.0, x); }
+};
+
+TEST(Newton, SpringChainReachesEvenlySpacedEquilibrium) {
+  ChainProblem problem;
+  SpringChain chain = problem.objective();
+  // Derivative sanity of the test objective itself, independent of the solver.
+  const auto energy = [&](const Eigen::VectorXd& y) { return chain.value(y); };
+  const Eigen::VectorXd fd = test::fd_gradient(energy, problem.x, 1e-6);
+  Eigen::VectorXd g;
+  chain.gradient(problem.x, g);
+  ASSERT_LT(test::relative_error(g, fd), 1e-7);
+  chain.pins_moved = false;  // the finite differences moved them on purpose
+
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(chain, problem.x, problem.dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_FALSE(chain.pins_moved);
+  for (int i = 0; i < ChainProblem::kVertices; ++i)
+    EXPECT_LT((problem.x.segment<3>(3 * i) - problem.even_point(i)).norm(), 1e-9) << "vertex " << i;
+  EXPECT_EQ(problem.x.segment<3>(0), problem.start);
+  // Every spring stretched by L/2: E = (n − 1) · k/2 · (L/2)².
+  EXPECT_NEAR(result.energy, (ChainProblem::kVertices - 1) * 0.5 * 10.0 * 0.25, 1e-12);
+  EXPECT_LT(result.gradient_norm, 1e-8);
+
+  // Quadratic convergence: once ‖g‖ is small, the next residual is about its square
+  // (order log g_{k+1} / log g_k ≥ 1.8 for some consecutive pair), with full steps.
+  bool quadratic_step = false;
+  for (std::size_t k = 0; k + 1 < result.history.size(); ++k) {
+    const double gk = result.history[k].gradient_norm;
+    const double gk1 = result.history[k + 1].gradient_norm;
+    if (gk < 1e-2 && gk > 1e-12 && gk1 > 0.0 && std::log(gk1) / std::log(gk) >= 1.8) {
+      quadratic_step = true;
+      EXPECT_EQ(result.history[k].step_length, 1.0);
+    }
+  }
+  EXPECT_TRUE(quadratic_step);
+  // Energies decrease monotonically.
+  for (std::size_t k = 0; k + 1 < result.history.size(); ++k)
+    EXPECT_LE(result.history[k + 1].energy, result.history[k].energy * (1 + 1e-12));
+}
+
+TEST(Newton, ReusesAnalysisAcrossCalls) {
+  ChainProblem problem;
+  SpringChain chain = problem.objective();
+  NewtonSolver solver;
+  NewtonSettings settings = tight_settings();
+  const NewtonResult first = solver.minimize(chain, problem.x, problem.dofs, settings);
+  ASSERT_GE(first.history.size(), 2u);
+  EXPECT_TRUE(first.history[0].pattern_changed);
+  for (std::size_t k = 1; k < first.history.size(); ++k)
+    EXPECT_FALSE(first.history[k].pattern_changed);
+
+  // Perturb and solve again with the same solver: same stencils, no new analysis.
+  problem.x.segment<3>(15) += Eigen::Vector3d(0.2, -0.1, 0.05);
+  const NewtonResult second = solver.minimize(chain, problem.x, problem.dofs, settings);
+  ASSERT_TRUE(second.converged);
+  for (const NewtonIteration& record : second.history) EXPECT_FALSE(record.pattern_changed);
+}
+
+TEST(Newton, MaxIterationsReturnsUnconverged) {
+  ChainProblem problem;
+  SpringChain chain = problem.objective();
+  NewtonSettings settings = tight_settings();
+  settings.max_iterations = 2;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(chain, problem.x, problem.dofs, settings);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.iterations, 2);
+  ASSERT_EQ(result.history.size(), 3u);
+  EXPECT_EQ(result.history.back().step_length, 0.0);
+  EXPECT_GE(result.step_norm, settings.tolerance);
+}
+
+TEST(Newton, StatisticsAddUp) {
+  ChainProblem problem;
+  SpringChain chain = problem.objective();
+  NewtonSolver solver;
+  std::vector<NewtonIteration> reported;
+  const NewtonResult result = solver.minimize(
+      chain, problem.x, problem.dofs, tight_settings(),
+      [&](const NewtonIteration& record) { reported.push_back(record); });
+  ASSERT_EQ(reported.size(), result.history.size());
+  PhaseTimes sum;
+  for (std::size_t k = 0; k < reported.size(); ++k) {
+    const NewtonIteration& record = reported[k];
+    EXPECT_EQ(record.iteration, static_cast<int>(k));
+    EXPECT_EQ(record.energy, result.history[k].energy);
+    EXPECT_GE(record.times.assembly, 0.0);
+    EXPECT_GE(record.times.factorization, 0.0);
+    EXPECT_GE(record.times.solve, 0.0);
+    EXPECT_GE(record.times.line_search, 0.0);
+    EXPECT_GE(record.gradient_norm, 0.0);
+    sum += record.times;
+  }
+  EXPECT_GT(result.times.assembly, 0.0);
+  EXPECT_GT(result.times.factorization, 0.0);
+  EXPECT_GT(result.times.line_search, 0.0);
+  EXPECT_NEAR(sum.assembly, result.times.assembly, 1e-12);
+  EXPECT_NEAR(sum.factorization, result.times.factorization, 1e-12);
+  EXPECT_NEAR(sum.solve, result.times.solve, 1e-12);
+  EXPECT_NEAR(sum.line_search, result.times.line_search, 1e-12);
+  EXPECT_LE(result.times.total(), result.wall_seconds);
+  EXPECT_EQ(result.energy, result.history.back().energy);
+}
+
+TEST(Newton, NonFiniteStartIsNamed) {
+  NewtonSolver solver;
+  const DofMap dofs(2, {});
+  ProbeQuadratic probe(6, 1.0);
+
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
+  x[4] = kNaN;
+  EXPECT_TRUE(contains(numerical_error_message([&] { solver.minimize(probe, x, dofs, {}); }),
+                       "initial position is nan at DOF 4 (vertex 1, y)"));
+
+  Quadratic bad_value(Eigen::VectorXd::Constant(6, kNaN), Eigen::VectorXd::Zero(6), {}, 0.0);
+  x.setZero();
+  x[0] = 1.0;
+  EXPECT_TRUE(contains(numerical_error_message([&] { solver.minimize(bad_value, x, dofs, {}); }),
+                       "objective value is nan at the initial point"));
+
+  // A non-finite gradient at a fixed DOF is ignored; at a free one it is named.
+  class InfiniteGradient : public ProbeQuadratic {
+   public:
+    InfiniteGradient(Eigen::Index bad_dof) : ProbeQuadratic(6, 1.0), bad_dof_(bad_dof) {}
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+      ProbeQuadratic::gradient(x, g);
+      g[bad_dof_] = std::numeric_limits<double>::infinity();
+    }
+
+   private:
+    Eigen::Index bad_dof_;
+  };
+  const DofMap first_pinned(2, {0});
+  InfiniteGradient at_fixed(2);
+  x.setZero();
+  EXPECT_TRUE(solver.minimize(at_fixed, x, first_pinned, {}).converged);
+  InfiniteGradient at_free(4);
+  x.setZero();
+  const std::string message =
+      numerical_error_message([&] { solver.minimize(at_free, x, first_pinned, {}); });
+  EXPECT_TRUE(contains(message, "gradient is inf at DOF 4 (vertex 1, y) at the initial point"))
+      << message;
+}
+
+TEST(Newton, NanAwayFromIterateForcesBacktracking) {
+  ProbeQuadratic probe(6, 3.0);
+  probe.nan_radius = 0.6;
+  const DofMap dofs(2, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_LT((x.array() - 3.0).abs().maxCoeff(), 1e-12);
+  EXPECT_LT(result.history[0].step_length, 1.0);
+  EXPECT_GT(result.history[0].line_search_trials, 1);
+  for (std::size_t k = 1; k < probe.iterates.size(); ++k)
+    EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.6)
+        << "accepted a point where the energy is nan";
+}
+
+TEST(Newton, RespectsMaxFeasibleStep) {
+  ProbeQuadratic probe(3, -2.0);
+  probe.max_displacement = 0.25;
+  const DofMap dofs(1, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_LT((x.array() + 2.0).abs().maxCoeff(), 1e-12);
+  EXPECT_GE(result.iterations, 8);  // 2 / 0.25 steps at least
+  for (const NewtonIteration& record : result.history)
+    EXPECT_LE(record.step_length, record.feasible_step);
+  for (std::size_t k = 1; k < probe.iterates.size(); ++k)
+    EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.25 + 1e-15);
+}
+
+TEST(Newton, LineSearchFailureIsReported) {
+  // max_feasible_step = 0: no step can be taken.
+  ProbeQuadratic blocked(3, 1.0);
+  blocked.max_displacement = 0.0;
+  const DofMap dofs(1, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  NewtonSolver solver;
+  std::string message = numerical_error_message([&] { solver.minimize(blocked, x, dofs, {}); });
+  EXPECT_TRUE(contains(message, "line search failed at iteration 0")) << message;
+
+  // A gradient inconsistent with the energy: the "descent" direction increases E every time.
+  class WrongGradient : public ProbeQuadratic {
+   public:
+    using ProbeQuadratic::ProbeQuadratic;
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+      ProbeQuadratic::gradient(x, g);
+      g = -g;
+    }
+  } wrong(3, 1.0);
+  message = numerical_error_message([&] { solver.minimize(wrong, x, dofs, {}); });
+  EXPECT_TRUE(contains(message, "line search failed at iteration 0, ‖g‖ = 1.732")) << message;
+  EXPECT_TRUE(contains(message, "40 trials")) << message;
+  EXPECT_EQ(x, Eigen::VectorXd::Zero(3)) << "a failed line search must not move x";
+}
+
+TEST(Newton, IndefiniteHessianFallsBackToShift) {
+  // E = Σ (xᵢ² − 1)² with its exact (unprojected) Hessian 12xᵢ² − 4, negative at x₀ = 0.1.
+  class DoubleWell : public Objective {
+   public:
+    [[nodiscard]] Eigen::Index size() const override { return 3; }
+    double value(const Eigen::VectorXd& x) override {
+      return (x.array().square() - 1.0).square().sum();
+    }
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+      g = (4.0 * x.array() * (x.array().square() - 1.0)).matrix();
+    }
+    void hessian(const Eigen::VectorXd& x, HessianBlocks& h) override {
+      h.diagonal = (12.0 * x.array().square() - 4.0).matrix();
+      h.batches.clear();
+    }
+  } well;
+  Eigen::VectorXd x(3);
+  x << 0.1, 2.0, -2.0;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(well, x, DofMap(1, {}), tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_EQ(result.history[0].direction, DirectionKind::shifted_newton);
+  EXPECT_GT(result.history[0].shift, 0.0);
+  EXPECT_EQ(result.history.back().direction, DirectionKind::newton);
+  EXPECT_LT((x.array().abs() - 1.0).abs().maxCoeff(), 1e-10);
+}
+
+TEST(Newton, NegativeDefiniteHessianFallsBackToGradient) {
+  // E = ½|x|² with a wrong Hessian −I: no shift up to the diagonal's scale helps.
+  class WrongCurvature : public Objective {
+   public:
+    [[nodiscard]] Eigen::Index size() const override { return 3; }
+    double value(const Eigen::VectorXd& x) override { return 0.5 * x.squaredNorm(); }
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override { g = x; }
+    void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+      h.diagonal = -Eigen::VectorXd::Ones(3);
+      h.batches.clear();
+    }
+  } wrong;
+  Eigen::VectorXd x(3);
+  x << 1.0, -2.0, 0.5;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(wrong, x, DofMap(1, {}), tight_settings());
+  ASSERT_TRUE(result.converged);
+  EXPECT_EQ(result.history[0].direction, DirectionKind::gradient);
+  EXPECT_EQ(x, Eigen::VectorXd::Zero(3));
+}
+
+TEST(Newton, RejectsBadSettings) {
+  ProbeQuadratic probe(3, 1.0);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  NewtonSolver solver;
+  NewtonSettings settings;
+  settings.step_scale = 0.0;
+  EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
+  settings = NewtonSettings{};
+  settings.backtracking = 1.0;
+  EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
+}
+
+}  // namespace
+}  // namespace psq
