@@ -32,6 +32,10 @@ struct VertexSelector {
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
   int boundary_loop = 0;   ///< index into the shell's boundary loops, ordered by size, largest first
   std::vector<int> indices;
+  /// Where the selector was written (scene file and line; empty / 0 when built in code), so
+  /// that a selection that turns out empty on the built mesh can be reported there.
+  std::filesystem::path source_file;
+  long source_line = 0;
 };
 
 /// A rigid motion applied to a pinned set between two times, linearly in time: at time t the

@@ -1,0 +1,588 @@
+#include "engine/scene/scene_reader.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <type_traits>
+
+#include "engine/core/error.hpp"
+#include "engine/scene/key_suggestion.hpp"
+
+namespace psq {
+namespace {
+
+namespace fs = std::filesystem;
+using Keys = std::vector<std::string>;
+
+std::string type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a floating-point number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::date:
+    case toml::node_type::time:
+    case toml::node_type::date_time:
+      return "a date or time";
+    case toml::node_type::none:
+      break;
+  }
+  return "nothing";
+}
+
+long line_of(const toml::node& node) { return static_cast<long>(node.source().begin.line); }
+
+std::string quoted_list(const Keys& keys) {
+  std::string out;
+  for (const std::string& key : keys) out += (out.empty() ? "'" : ", '") + key + "'";
+  return out;
+}
+
+/// One table of a scene file. Hands out its values by key with type checks and defaults, and
+/// raises InputErrors that name the file, the line, the key and the table ("in [shell.pin]").
+class Section {
+ public:
+  /// `name` is the dotted path of the table ("shell.material"); empty for the top level.
+  Section(const toml::table& table, std::string name, std::string file)
+      : table_(table),
+        name_(std::move(name)),
+        file_(std::move(file)),
+        line_(name_.empty() ? 0 : line_of(table)) {}
+
+  [[nodiscard]] const std::string& file() const { return file_; }
+  [[nodiscard]] long line() const { return line_; }
+  [[nodiscard]] bool has(std::string_view key) const { return table_.contains(key); }
+
+  /// "in [shell.material]" or "at the top level".
+  [[nodiscard]] std::string where() const {
+    return name_.empty() ? "at the top level" : fmt::format("in [{}]", name_);
+  }
+
+  /// Line of a key's value, or of the table when the key is absent.
+  [[nodiscard]] long line(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    return node ? line_of(*node) : line_;
+  }
+
+  [[noreturn]] void fail(long line, const std::string& message) const {
+    throw InputError(located_message(file_, line, message));
+  }
+
+  /// Fails at the key's line with "'key' in [table] must be <requirement>".
+  void check(bool ok, std::string_view key, const std::string& requirement) const {
+    if (!ok) fail(line(key), fmt::format("'{}' {} must be {}", key, where(), requirement));
+  }
+
+  /// Rejects every key not in `allowed`, the first in the file first, suggesting the
+  /// nearest allowed key or listing them all.
+  void allow_only(const Keys& allowed) const {
+    const toml::key* unknown = nullptr;
+    for (auto&& [key, value] : table_) {
+      if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
+      if (!unknown || key.source().begin.line < unknown->source().begin.line) unknown = &key;
+    }
+    if (!unknown) return;
+    const auto suggestion = suggest_key(unknown->str(), allowed);
+    const std::string hint = suggestion ? fmt::format("did you mean '{}'?", *suggestion)
+                                        : fmt::format("valid keys: {}", quoted_list(allowed));
+    fail(static_cast<long>(unknown->source().begin.line),
+         fmt::format("unknown key '{}' {}; {}", unknown->str(), where(), hint));
+  }
+
+  /// The value of an optional key, `fallback` when absent.
+  template <class T>
+  [[nodiscard]] T get(std::string_view key, T fallback) const {
+    const toml::node* node = table_.get(key);
+    return node ? convert<T>(key, *node) : fallback;
+  }
+  template <class T>
+  [[nodiscard]] std::optional<T> get_optional(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    return node ? std::optional<T>(convert<T>(key, *node)) : std::nullopt;
+  }
+  template <class T>
+  [[nodiscard]] T get_required(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    if (!node) fail(line_, fmt::format("missing required key '{}' {}", key, where()));
+    return convert<T>(key, *node);
+  }
+
+  [[nodiscard]] Section table(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    if (!node) fail(line_, fmt::format("missing required table '{}' {}", key, where()));
+    return child(key, *node);
+  }
+  [[nodiscard]] std::optional<Section> optional_table(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    return node ? std::optional<Section>(child(key, *node)) : std::nullopt;
+  }
+
+  /// The tables of an array of tables ([[key]] or key = [{...}, ...]); none when absent.
+  [[nodiscard]] std::vector<Section> tables(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    if (!node) return {};
+    const toml::array* array = node->as_array();
+    if (!array || (!array->empty() && !array->is_array_of_tables()))
+      fail(line_of(*node), fmt::format("expected an array of tables for '{}' {} (write [[{}]] "
+                                       "sections or a list of {{ ... }}), got {}",
+                                       key, where(), dotted(key), type_name(*node)));
+    std::vector<Section> out;
+    for (const toml::node& element : *array)
+      out.emplace_back(*element.as_table(), dotted(key), file_);
+    return out;
+  }
+
+ private:
+  [[nodiscard]] std::string dotted(std::string_view key) const {
+    return name_.empty() ? std::string(key) : fmt::format("{}.{}", name_, key);
+  }
+
+  [[nodiscard]] Section child(std::string_view key, const toml::node& node) const {
+    if (!node.is_table())
+      fail(line_of(node),
+           fmt::format("expected a table for '{}' {}, got {}", key, where(), type_name(node)));
+    return Section(*node.as_table(), dotted(key), file_);
+  }
+
+  [[noreturn]] void wrong_type(std::string_view key, const toml::node& node,
+                               std::string_view expected) const {
+    fail(line_of(node),
+         fmt::format("expected {} for '{}' {}, got {}", expected, key, where(), type_name(node)));
+  }
+
+  [[nodiscard]] double to_number(std::string_view key, const toml::node& node) const {
+    double value = 0;
+    if (const auto* i = node.as_integer())
+      value = static_cast<double>(i->get());
+    else if (const auto* f = node.as_floating_point())
+      value = f->get();
+    else
+      wrong_type(key, node, "a number");
+    if (!std::isfinite(value)) wrong_type(key, node, "a finite number");
+    return value;
+  }
+
+  [[nodiscard]] int to_integer(std::string_view key, const toml::node& node) const {
+    const auto* i = node.as_integer();
+    if (!i) wrong_type(key, node, "an integer");
+    if (i->get() < INT_MIN || i->get() > INT_MAX) wrong_type(key, node, "an integer of int range");
+    return static_cast<int>(i->get());
+  }
+
+  /// An array of exactly `size` numbers, e.g. a point [x, y, z].
+  template <int size>
+  [[nodiscard]] Eigen::Matrix<double, size, 1> to_vector(std::string_view key,
+                                                         const toml::node& node) const {
+    const std::string expected = fmt::format("an array of {} numbers", size);
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != static_cast<std::size_t>(size)) wrong_type(key, node, expected);
+    Eigen::Matrix<double, size, 1> out;
+    for (int k = 0; k < size; ++k) {
+      const toml::node& element = *array->get(static_cast<std::size_t>(k));
+      if (!element.is_number()) wrong_type(key, node, expected);
+      out[k] = to_number(key, element);
+    }
+    return out;
+  }
+
+  template <class T>
+  [[nodiscard]] T convert(std::string_view key, const toml::node& node) const {
+    if constexpr (std::is_same_v<T, double>) {
+      return to_number(key, node);
+    } else if constexpr (std::is_same_v<T, int>) {
+      return to_integer(key, node);
+    } else if constexpr (std::is_same_v<T, bool>) {
+      if (!node.is_boolean()) wrong_type(key, node, "true or false");
+      return node.as_boolean()->get();
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      if (!node.is_string()) wrong_type(key, node, "a string");
+      return node.as_string()->get();
+    } else if constexpr (std::is_same_v<T, std::vector<int>>) {
+      const toml::array* array = node.as_array();
+      if (!array) wrong_type(key, node, "an array of integers");
+      std::vector<int> out;
+      for (const toml::node& element : *array) out.push_back(to_integer(key, element));
+      return out;
+    } else {
+      return to_vector<T::RowsAtCompileTime>(key, node);
+    }
+  }
+
+  const toml::table& table_;
+  std::string name_;
+  std::string file_;
+  long line_;
+};
+
+std::string format_vector(const Eigen::Vector3d& v) {
+  return fmt::format("[{:g}, {:g}, {:g}]", v.x(), v.y(), v.z());
+}
+
+/// Fails unless the value of `key` is a nonzero direction.
+void check_direction(const Section& section, std::string_view key, const Eigen::Vector3d& axis) {
+  section.check(axis.norm() > 0, key, "a nonzero direction (got [0, 0, 0])");
+}
+
+/// One of `choices` as written for `key`, suggesting the nearest one on a typo.
+std::string read_choice(const Section& section, std::string_view key, const Keys& choices,
+                        std::optional<std::string> fallback = std::nullopt) {
+  const std::string value =
+      fallback ? section.get<std::string>(key, *fallback) : section.get_required<std::string>(key);
+  if (std::find(choices.begin(), choices.end(), value) != choices.end()) return value;
+  const auto suggestion = suggest_key(value, choices);
+  section.fail(section.line(key),
+               fmt::format("unknown {} '{}' {}; {}", key, value, section.where(),
+                           suggestion ? fmt::format("did you mean '{}'?", *suggestion)
+                                      : fmt::format("expected one of {}", quoted_list(choices))));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes
+
+const Keys kSheetKeys = {"generator", "width", "height", "edge_length", "structured", "holes"};
+const Keys kCylinderKeys = {"generator", "radius", "height", "edge_length"};
+const Keys kSphereKeys = {"generator", "radius", "edge_length"};
+
+double read_positive(const Section& section, std::string_view key) {
+  const double value = section.get_required<double>(key);
+  section.check(value > 0, key, fmt::format("positive (got {:g})", value));
+  return value;
+}
+
+/// The target edge length, which must be positive and smaller than the shape's smallest size.
+double read_edge_length(const Section& mesh, double smallest_size, std::string_view size_name) {
+  const double edge = read_positive(mesh, "edge_length");
+  mesh.check(edge < smallest_size, "edge_length",
+             fmt::format("smaller than the {} ({:g}); got {:g}", size_name, smallest_size, edge));
+  return edge;
+}
+
+std::vector<SheetGenerator::Hole> read_holes(const Section& mesh, const SheetGenerator& sheet) {
+  std::vector<SheetGenerator::Hole> holes;
+  for (const Section& hole : mesh.tables("holes")) {
+    hole.allow_only({"center", "radius"});
+    const Eigen::Vector2d center = hole.get_required<Eigen::Vector2d>("center");
+    const double radius = read_positive(hole, "radius");
+    hole.check(std::abs(center.x()) + radius < 0.5 * sheet.width &&
+                   std::abs(center.y()) + radius < 0.5 * sheet.height,
+               "radius",
+               fmt::format("small enough for the hole to lie inside the {:g} × {:g} "
+                           "sheet (centred at the origin)",
+                           sheet.width, sheet.height));
+    for (const SheetGenerator::Hole& other : holes)
+      hole.check(std::hypot(center.x() - other.center_x, center.y() - other.center_y) >
+                     radius + other.radius,
+                 "radius", "small enough for the hole not to overlap an earlier hole");
+    holes.push_back({center.x(), center.y(), radius});
+  }
+  return holes;
+}
+
+SheetGenerator read_sheet(const Section& mesh) {
+  mesh.allow_only(kSheetKeys);
+  SheetGenerator sheet;
+  sheet.width = read_positive(mesh, "width");
+  sheet.height = read_positive(mesh, "height");
+  sheet.edge_length =
+      read_edge_length(mesh, std::min(sheet.width, sheet.height), "sheet's width and height");
+  sheet.structured = mesh.get<bool>("structured", false);
+  sheet.holes = read_holes(mesh, sheet);
+  if (sheet.structured && !sheet.holes.empty())
+    mesh.fail(mesh.line("holes"), fmt::format("'holes' {} need an unstructured sheet "
+                                              "(structured = false)",
+                                              mesh.where()));
+  return sheet;
+}
+
+CylinderGenerator read_cylinder(const Section& mesh) {
+  mesh.allow_only(kCylinderKeys);
+  CylinderGenerator cylinder;
+  cylinder.radius = read_positive(mesh, "radius");
+  cylinder.height = read_positive(mesh, "height");
+  cylinder.edge_length = read_edge_length(mesh, std::min(cylinder.radius, cylinder.height),
+                                          "cylinder's radius and height");
+  return cylinder;
+}
+
+SphereGenerator read_sphere(const Section& mesh) {
+  mesh.allow_only(kSphereKeys);
+  SphereGenerator sphere;
+  sphere.radius = read_positive(mesh, "radius");
+  sphere.edge_length = read_edge_length(mesh, sphere.radius, "sphere's radius");
+  return sphere;
+}
+
+/// A mesh file, resolved relative to the scene file's directory; it must exist.
+fs::path read_mesh_file(const Section& mesh, const fs::path& scene_path) {
+  mesh.allow_only({"file"});
+  const std::string written = mesh.get_required<std::string>("file");
+  const fs::path resolved = fs::absolute(scene_path.parent_path() / written).lexically_normal();
+  std::string extension = resolved.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  mesh.check(extension == ".obj" || extension == ".ply" || extension == ".off", "file",
+             fmt::format("an .obj, .ply or .off file (got '{}')", written));
+  if (!fs::is_regular_file(resolved))
+    mesh.fail(mesh.line("file"), fmt::format("mesh file '{}' not found: {} does not exist", written,
+                                             resolved.string()));
+  return resolved;
+}
+
+void read_placement(const Section& shell, MeshSource& source) {
+  const auto placement = shell.optional_table("placement");
+  if (!placement) return;
+  placement->allow_only({"scale", "rotation_axis", "rotation_degrees", "translation"});
+  source.scale = placement->get<double>("scale", source.scale);
+  placement->check(source.scale > 0, "scale", fmt::format("positive (got {:g})", source.scale));
+  source.rotation_axis = placement->get<Eigen::Vector3d>("rotation_axis", source.rotation_axis);
+  check_direction(*placement, "rotation_axis", source.rotation_axis);
+  source.rotation_degrees = placement->get<double>("rotation_degrees", source.rotation_degrees);
+  source.translation = placement->get<Eigen::Vector3d>("translation", source.translation);
+}
+
+MeshSource read_mesh_source(const Section& shell, const fs::path& scene_path) {
+  const Section mesh = shell.table("mesh");
+  MeshSource source;
+  if (mesh.has("file") && mesh.has("generator"))
+    mesh.fail(mesh.line("generator"),
+              fmt::format("give either 'file' or 'generator' {}, not both", mesh.where()));
+  if (mesh.has("file")) {
+    source.kind = MeshSource::Kind::File;
+    source.file = read_mesh_file(mesh, scene_path);
+  } else if (!mesh.has("generator")) {
+    mesh.fail(mesh.line(), fmt::format("missing 'file' or 'generator' {}", mesh.where()));
+  } else {
+    const std::string generator = read_choice(mesh, "generator", {"sheet", "cylinder", "sphere"});
+    if (generator == "sheet") {
+      source.kind = MeshSource::Kind::Sheet;
+      source.sheet = read_sheet(mesh);
+    } else if (generator == "cylinder") {
+      source.kind = MeshSource::Kind::Cylinder;
+      source.cylinder = read_cylinder(mesh);
+    } else {
+      source.kind = MeshSource::Kind::Sphere;
+      source.sphere = read_sphere(mesh);
+    }
+  }
+  read_placement(shell, source);
+  return source;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Materials, selectors, pins, loads
+
+Material read_material(const Section& shell) {
+  const Section section = shell.table("material");
+  section.allow_only({"youngs_modulus", "poisson_ratio", "density", "thickness"});
+  Material material;
+  material.youngs_modulus = read_positive(section, "youngs_modulus");
+  material.poisson_ratio = section.get_required<double>("poisson_ratio");
+  section.check(material.poisson_ratio > -1 && material.poisson_ratio < 0.5, "poisson_ratio",
+                fmt::format("in (-1, 0.5) (got {:g})", material.poisson_ratio));
+  material.density = read_positive(section, "density");
+  material.thickness = read_positive(section, "thickness");
+  return material;
+}
+
+const Keys kSelectorKeys = {"box", "boundary_loop", "vertices"};
+
+/// Keys of a table that also holds a vertex selector.
+Keys with_selector_keys(Keys keys) {
+  keys.insert(keys.end(), kSelectorKeys.begin(), kSelectorKeys.end());
+  return keys;
+}
+
+/// The selector written in `owner` (a pin or load table): exactly one of box, boundary_loop
+/// or vertices.
+VertexSelector read_selector(const Section& owner) {
+  Keys given;
+  for (const std::string& key : kSelectorKeys)
+    if (owner.has(key)) given.push_back(key);
+  if (given.empty())
+    owner.fail(owner.line(), fmt::format("missing a vertex selector {}: give one of {}",
+                                         owner.where(), quoted_list(kSelectorKeys)));
+  if (given.size() > 1)
+    owner.fail(owner.line(given[1]), fmt::format("several vertex selectors {} ({}); give exactly "
+                                                 "one",
+                                                 owner.where(), quoted_list(given)));
+  const std::string& key = given.front();
+  VertexSelector selector;
+  selector.source_file = owner.file();
+  selector.source_line = owner.line(key);
+  if (key == "box") {
+    const Section box = owner.table("box");
+    box.allow_only({"min", "max"});
+    selector.kind = VertexSelector::Kind::Box;
+    selector.box_min = box.get_required<Eigen::Vector3d>("min");
+    selector.box_max = box.get_required<Eigen::Vector3d>("max");
+    box.check((selector.box_min.array() <= selector.box_max.array()).all(), "max",
+              fmt::format("at least min in every coordinate (min {}, max {})",
+                          format_vector(selector.box_min), format_vector(selector.box_max)));
+  } else if (key == "boundary_loop") {
+    selector.kind = VertexSelector::Kind::BoundaryLoop;
+    selector.boundary_loop = owner.get_required<int>("boundary_loop");
+    owner.check(selector.boundary_loop >= 0, "boundary_loop",
+                fmt::format("a loop index ≥ 0 (got {})", selector.boundary_loop));
+  } else {
+    selector.kind = VertexSelector::Kind::List;
+    selector.indices = owner.get_required<std::vector<int>>("vertices");
+    owner.check(!selector.indices.empty(), "vertices", "a non-empty list of vertex indices");
+    for (int v : selector.indices)
+      owner.check(v >= 0, "vertices", fmt::format("a list of indices ≥ 0 (got {})", v));
+  }
+  return selector;
+}
+
+RigidMotion read_motion(const Section& section) {
+  section.allow_only({"start", "end", "translation", "axis_point", "axis", "angle_degrees"});
+  RigidMotion motion;
+  motion.start_time = section.get<double>("start", motion.start_time);
+  motion.end_time = section.get<double>("end", motion.end_time);
+  section.check(motion.end_time >= motion.start_time, "end",
+                fmt::format("at least start ({:g}); got {:g}", motion.start_time, motion.end_time));
+  motion.translation = section.get<Eigen::Vector3d>("translation", motion.translation);
+  motion.axis_point = section.get<Eigen::Vector3d>("axis_point", motion.axis_point);
+  motion.axis_direction = section.get<Eigen::Vector3d>("axis", motion.axis_direction);
+  check_direction(section, "axis", motion.axis_direction);
+  motion.angle_degrees = section.get<double>("angle_degrees", motion.angle_degrees);
+  return motion;
+}
+
+std::string read_name(const Section& section) {
+  const std::string name = section.get_required<std::string>("name");
+  section.check(!name.empty(), "name", "a non-empty string");
+  return name;
+}
+
+PinnedSet read_pin(const Section& section) {
+  section.allow_only(with_selector_keys({"name", "motion"}));
+  PinnedSet pin;
+  pin.name = read_name(section);
+  pin.selector = read_selector(section);
+  for (const Section& motion : section.tables("motion")) pin.motions.push_back(read_motion(motion));
+  return pin;
+}
+
+Load read_load(const Section& section) {
+  section.allow_only(with_selector_keys({"kind", "force"}));
+  Load load;
+  load.kind = read_choice(section, "kind", {"point", "line"}, "point") == "line"
+                  ? Load::Kind::Line
+                  : Load::Kind::Point;
+  load.selector = read_selector(section);
+  load.total_force = section.get_required<Eigen::Vector3d>("force");
+  return load;
+}
+
+/// Fails if `name` was already used by an earlier item of the same kind.
+void check_unique_name(const Section& section, std::set<std::string>& used, const std::string& name,
+                       std::string_view kind) {
+  if (!used.insert(name).second)
+    section.fail(section.line("name"), fmt::format("{} name '{}' is used twice; names must be "
+                                                   "unique",
+                                                   kind, name));
+}
+
+Shell read_shell(const Section& section, const fs::path& scene_path) {
+  section.allow_only({"name", "mesh", "placement", "material", "pin", "load"});
+  Shell shell;
+  shell.name = read_name(section);
+  shell.mesh = read_mesh_source(section, scene_path);
+  shell.material = read_material(section);
+  std::set<std::string> pin_names;
+  for (const Section& pin : section.tables("pin")) {
+    shell.pins.push_back(read_pin(pin));
+    check_unique_name(pin, pin_names, shell.pins.back().name, "pin");
+  }
+  for (const Section& load : section.tables("load")) shell.loads.push_back(read_load(load));
+  return shell;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Top level
+
+TimeStepping read_time(const Section& root) {
+  TimeStepping time;
+  const auto section = root.optional_table("time");
+  if (!section) return time;
+  section->allow_only({"step", "frames"});
+  time.step = section->get<double>("step", time.step);
+  section->check(time.step > 0, "step", fmt::format("positive (got {:g})", time.step));
+  time.frames = section->get<int>("frames", time.frames);
+  section->check(time.frames >= 1, "frames", fmt::format("at least 1 (got {})", time.frames));
+  return time;
+}
+
+SolverSettings read_solver(const Section& root) {
+  SolverSettings solver;
+  const auto section = root.optional_table("solver");
+  if (!section) return solver;
+  section->allow_only({"tolerance", "max_iterations"});
+  solver.tolerance = section->get_optional<double>("tolerance");
+  if (solver.tolerance)
+    section->check(*solver.tolerance > 0, "tolerance",
+                   fmt::format("positive (got {:g})", *solver.tolerance));
+  solver.max_iterations = section->get<int>("max_iterations", solver.max_iterations);
+  section->check(solver.max_iterations >= 1, "max_iterations",
+                 fmt::format("at least 1 (got {})", solver.max_iterations));
+  return solver;
+}
+
+toml::table parse_toml(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(located_message(path.string(), 0, "cannot open the scene file"));
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string source = path.string();
+  try {
+    return toml::parse(text.str(), std::string_view(source));
+  } catch (const toml::parse_error& error) {
+    std::string message = fmt::format("TOML syntax error: {}", error.description());
+    // TOML 1.0 inline tables end at the line's end, a frequent surprise.
+    if (message.find("inline table") != std::string::npos &&
+        message.find("'\\n'") != std::string::npos)
+      message += " (an inline table { ... } must fit on one line; use a [table] section instead)";
+    throw InputError(
+        located_message(source, static_cast<long>(error.source().begin.line), message));
+  }
+}
+
+}  // namespace
+
+Scene read_scene(const fs::path& path) {
+  const toml::table document = parse_toml(path);
+  const Section root(document, "", path.string());
+  root.allow_only({"name", "gravity", "time", "solver", "shell"});
+  Scene scene;
+  scene.source = path;
+  scene.name = root.get<std::string>("name", path.stem().string());
+  root.check(!scene.name.empty(), "name", "a non-empty string");
+  scene.gravity = root.get<Eigen::Vector3d>("gravity", scene.gravity);
+  scene.time = read_time(root);
+  scene.solver = read_solver(root);
+  const std::vector<Section> shells = root.tables("shell");
+  if (shells.empty()) root.fail(0, "the scene has no shell; add at least one [[shell]] section");
+  std::set<std::string> shell_names;
+  for (const Section& shell : shells) {
+    scene.shells.push_back(read_shell(shell, path));
+    check_unique_name(shell, shell_names, scene.shells.back().name, "shell");
+  }
+  return scene;
+}
+
+}  // namespace psq
