@@ -1,1 +1,32 @@
-int main(){return 0;}
+// psq: the command-line face of PSQ. Every engine exception is caught here and turned into a
+// message on stderr and an exit code: 1 bad input, 2 numerical failure, 3 not converged,
+// 4 unexpected internal error.
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <iostream>
+
+#include "engine/core/error.hpp"
+#include "runner/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"PSQ: progressive shell quasistatics"};
+  app.set_version_flag("--version", std::string(PSQ_VERSION));
+  app.require_subcommand(1);
+  psq::runner::register_sim_command(app);
+  try {
+    app.parse(argc, argv);
+    return psq::runner::run_selected_command(app);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const psq::InputError& e) {
+    std::cerr << "psq: error: " << e.what() << '\n';
+    return psq::runner::kExitInputError;
+  } catch (const psq::NumericalError& e) {
+    std::cerr << "psq: numerical failure: " << e.what() << '\n';
+    return psq::runner::kExitNumericalError;
+  } catch (const std::exception& e) {
+    std::cerr << "psq: internal error: " << e.what() << '\n';
+    return psq::runner::kExitInternalError;
+  }
+}
