@@ -25,8 +25,13 @@ TriMesh make_structured_sheet(const SheetGenerator& spec) {
   int f = 0;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
-      mesh.triangles.row(f++) << id(i, j), id(i + 1, j), id(i + 1, j + 1);
-      mesh.triangles.row(f++) << id(i, j), id(i + 1, j + 1), id(i, j + 1);
+      if ((i + j) % 2 == 0) {
+        mesh.triangles.row(f++) << id(i, j), id(i + 1, j), id(i + 1, j + 1);
+        mesh.triangles.row(f++) << id(i, j), id(i + 1, j + 1), id(i, j + 1);
+      } else {
+        mesh.triangles.row(f++) << id(i, j), id(i + 1, j), id(i, j + 1);
+        mesh.triangles.row(f++) << id(i + 1, j), id(i + 1, j + 1), id(i, j + 1);
+      }
     }
   return mesh;
 }
