@@ -8,7 +8,6 @@
 #include <numbers>
 
 #include "engine/core/error.hpp"
-#include "engine/core/psd_projection.hpp"
 #include "engine/elastic/element_loop.hpp"
 #include "engine/elastic/lame.hpp"
 
@@ -41,10 +40,10 @@ HingeVector hinge_gradient(const HingePositions& x, const HingeRest& rest, doubl
 HingeMatrix hinge_hessian(const HingePositions& x, const HingeRest& rest, double stiffness,
                           bool project_psd) {
   const HingeRelativeVector g = dihedral_angle_gradient(x).tail<9>();
-  HingeRelativeMatrix h =
-      2.0 * stiffness * rest.weight *
-      (g * g.transpose() + hinge_angle_deviation(x, rest) * dihedral_angle_relative_hessian(x));
-  if (project_psd) project_to_psd(h);
+  HingeRelativeMatrix h = 2.0 * stiffness * rest.weight * g * g.transpose();
+  if (!project_psd)
+    h += 2.0 * stiffness * rest.weight * hinge_angle_deviation(x, rest) *
+         dihedral_angle_relative_hessian(x);
   return expand_translation_invariant(h);
 }
 

@@ -38,9 +38,12 @@ double hinge_energy(const HingePositions& x, const HingeRest& rest, double stiff
 /// ∇W = 2 k w (θ − θ̄) ∇θ. Throws NumericalError for a degenerate hinge.
 HingeVector hinge_gradient(const HingePositions& x, const HingeRest& rest, double stiffness);
 
-/// ∇²W = 2 k w [∇θ ∇θᵀ + (θ − θ̄) ∇²θ]. With project_psd the 9×9 block with x0 fixed is
-/// projected (W is translation invariant, so the 12×12 result is PSD, and unchanged when
-/// it already was). Throws NumericalError for a degenerate hinge.
+/// ∇²W = 2 k w [∇θ ∇θᵀ + (θ − θ̄) ∇²θ]. With project_psd, the Gauss–Newton term
+/// 2 k w ∇θ ∇θᵀ alone: PSD by construction, exact at θ = θ̄. It replaces the eigen-projection
+/// of the full block because it is ~15× cheaper (a 9×9 eigensolve was 5 µs per hinge, 80% of
+/// the assembly at 50k vertices) and converged in fewer Newton iterations on the example
+/// scenes (drape 199 vs 203, twist 581 vs 676 iterations over 25 frames).
+/// Throws NumericalError for a degenerate hinge.
 HingeMatrix hinge_hessian(const HingePositions& x, const HingeRest& rest, double stiffness,
                           bool project_psd);
 
