@@ -1,5 +1,7 @@
 #pragma once
 #include <CLI/CLI.hpp>
+#include <functional>
+#include <vector>
 
 namespace psq::runner {
 
@@ -8,10 +10,13 @@ inline constexpr int kExitNumericalError = 2;
 inline constexpr int kExitNotConverged = 3;
 inline constexpr int kExitInternalError = 4;
 
-/// Adds `psq sim SCENE --out DIR`.
-void register_sim_command(CLI::App& app);
+/// A subcommand and what runs it (returning the process exit code).
+struct Command {
+  CLI::App* app;
+  std::function<int()> run;
+};
 
-/// Runs the subcommand the user chose; returns the process exit code.
-int run_selected_command(CLI::App& app);
+/// Each adds one subcommand to `app` and its runner to `commands`.
+void register_sim_command(CLI::App& app, std::vector<Command>& commands);
 
 }  // namespace psq::runner

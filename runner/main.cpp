@@ -13,10 +13,13 @@ int main(int argc, char** argv) {
   CLI::App app{"PSQ: progressive shell quasistatics"};
   app.set_version_flag("--version", std::string(PSQ_VERSION));
   app.require_subcommand(1);
-  psq::runner::register_sim_command(app);
+  std::vector<psq::runner::Command> commands;
+  psq::runner::register_sim_command(app, commands);
   try {
     app.parse(argc, argv);
-    return psq::runner::run_selected_command(app);
+    for (const auto& command : commands)
+      if (command.app->parsed()) return command.run();
+    return psq::runner::kExitInternalError;
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const psq::InputError& e) {

@@ -22,15 +22,12 @@ struct SimOptions {
   std::string out;
 };
 
-SimOptions sim_options;
-CLI::App* sim_command = nullptr;
-
 void write_frame(const std::filesystem::path& dir, int frame, const TriMesh& rest, const Eigen::VectorXd& x) {
   TriMesh mesh{as_positions(x), rest.triangles};
   write_mesh(dir / fmt::format("frame_{:04d}.obj", frame), mesh);
 }
 
-int run_sim() {
+int run_sim(const SimOptions& sim_options) {
   const Scene scene = read_scene(sim_options.scene);
   const std::filesystem::path out = prepare_output_dir(sim_options.out);
   const bool terminal = ::isatty(STDERR_FILENO);
@@ -80,17 +77,14 @@ int run_sim() {
 
 }  // namespace
 
-void register_sim_command(CLI::App& app) {
-  sim_command = app.add_subcommand("sim", "Simulate a scene at its full resolution");
-  sim_command->add_option("scene", sim_options.scene, "Scene file (TOML, see docs/scene-format.md)")
+void register_sim_command(CLI::App& app, std::vector<Command>& commands) {
+  auto options = std::make_shared<SimOptions>();
+  CLI::App* command = app.add_subcommand("sim", "Simulate a scene at its full resolution");
+  command->add_option("scene", options->scene, "Scene file (TOML, see docs/scene-format.md)")
       ->required();
-  sim_command->add_option("--out", sim_options.out, "Output directory for frame meshes and summary.json")
+  command->add_option("--out", options->out, "Output directory for frame meshes and summary.json")
       ->required();
-}
-
-int run_selected_command(CLI::App& app) {
-  if (app.got_subcommand(sim_command)) return run_sim();
-  throw Error("no subcommand selected");
+  commands.push_back({command, [options] { return run_sim(*options); }});
 }
 
 }  // namespace psq::runner
