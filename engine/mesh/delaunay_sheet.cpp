@@ -15,7 +15,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/generators.hpp"
-#include "engine/mesh/mesh_io_checks.hpp"
+#include "engine/mesh/mesh_checks.hpp"
 
 namespace psq {
 namespace {

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "engine/mesh/mesh_io_checks.hpp"
+#include "engine/mesh/mesh_checks.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 
 namespace psq {

@@ -5,7 +5,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
-#include "engine/mesh/mesh_io_checks.hpp"
+#include "engine/mesh/mesh_checks.hpp"
 #include "engine/mesh/topology.hpp"
 
 namespace psq {

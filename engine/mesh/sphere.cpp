@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "engine/mesh/generators.hpp"
-#include "engine/mesh/mesh_io_checks.hpp"
+#include "engine/mesh/mesh_checks.hpp"
 
 namespace psq {
 namespace {

@@ -1,15 +1,15 @@
 #include <cmath>
-#include <fmt/format.h>
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/generators.hpp"
+#include "engine/mesh/mesh_checks.hpp"
 
 namespace psq {
 
 TriMesh make_structured_sheet(const SheetGenerator& spec) {
-  if (!(spec.width > 0 && spec.height > 0 && spec.edge_length > 0))
-    throw InputError(fmt::format("sheet: width ({}), height ({}) and edge_length ({}) must be positive",
-                                 spec.width, spec.height, spec.edge_length));
+  require_positive("sheet", "width", spec.width);
+  require_positive("sheet", "height", spec.height);
+  require_positive("sheet", "edge_length", spec.edge_length);
   if (!spec.holes.empty())
     throw InputError("sheet: holes need an unstructured sheet (structured = false)");
   const int nx = std::max(1, static_cast<int>(std::ceil(spec.width / spec.edge_length - 1e-9)));
