@@ -45,7 +45,7 @@ ProcessResult run_process(const std::string& program, const std::vector<std::str
   return result;
 }
 
-ProcessResult run_psq(const std::vector<std::string>& arguments) {
+ProcessResult run_psq([[maybe_unused]] const std::vector<std::string>& arguments) {
 #ifdef PSQ_EXECUTABLE
   return run_process(PSQ_EXECUTABLE, arguments);
 #else

@@ -1,0 +1,46 @@
+#include "db/job_records.hpp"
+
+#include <fmt/format.h>
+
+#include <numeric>
+#include <stdexcept>
+
+namespace psq::db {
+namespace {
+
+constexpr std::array<std::string_view, kAllJobStates.size()> kJobStateNames{
+    "queued", "running", "done", "failed", "cancelled"};
+constexpr std::array<std::string_view, 3> kLevelStatusNames{"running", "done", "failed"};
+
+template <class Enum, std::size_t N>
+Enum from_name(const std::array<std::string_view, N>& names, std::string_view name,
+               std::string_view what) {
+  for (std::size_t i = 0; i < N; ++i)
+    if (names[i] == name) return static_cast<Enum>(i);
+  throw std::invalid_argument(fmt::format("'{}' is not a {}", name, what));
+}
+
+}  // namespace
+
+std::string_view to_string(JobState state) {
+  return kJobStateNames[static_cast<std::size_t>(state)];
+}
+
+JobState job_state_from_string(std::string_view name) {
+  return from_name<JobState>(kJobStateNames, name, "job state");
+}
+
+std::string_view to_string(LevelStatus status) {
+  return kLevelStatusNames[static_cast<std::size_t>(status)];
+}
+
+LevelStatus level_status_from_string(std::string_view name) {
+  return from_name<LevelStatus>(kLevelStatusNames, name, "level status");
+}
+
+std::int64_t SweepStatus::total() const {
+  return std::accumulate(counts.begin(), counts.end(), std::int64_t{0},
+                         [](std::int64_t sum, const auto& entry) { return sum + entry.second; });
+}
+
+}  // namespace psq::db

@@ -1,0 +1,150 @@
+#pragma once
+// The values the job store takes and returns: jobs, leases, per-level records, sweep counts.
+// Plain data; the rules that move a job between states live in JobStore.
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace psq::db {
+
+/// Where a job is in its life. queued → running → done; running → queued (released, or a
+/// failed attempt with attempts left, or a lease that expired); running → failed (no attempts
+/// left, or a permanent failure); queued/running → cancelled; failed/cancelled → queued (retry).
+enum class JobState { queued, running, done, failed, cancelled };
+inline constexpr std::array kAllJobStates{JobState::queued, JobState::running, JobState::done,
+                                          JobState::failed, JobState::cancelled};
+std::string_view to_string(JobState state);
+/// Throws std::invalid_argument for a name that is not a state.
+JobState job_state_from_string(std::string_view name);
+
+/// Status of one hierarchy level of a job: running (an in-level snapshot), done, failed.
+enum class LevelStatus { running, done, failed };
+std::string_view to_string(LevelStatus status);
+/// Throws std::invalid_argument for a name that is not a level status.
+LevelStatus level_status_from_string(std::string_view name);
+
+/// How an attempt ended. `failed` is retried while attempts remain; `failed_permanently`
+/// (input the user must fix: retrying cannot help) ends the job at once.
+enum class Outcome { done, failed, failed_permanently };
+
+/// A job as a sweep submits it. `id` is the hash of the canonical parameters (computed by the
+/// sweep expansion); the same id always means the same job.
+struct NewJob {
+  std::string id;
+  nlohmann::json parameters;  ///< stored canonically: keys sorted, compact
+  std::string scene;          ///< the scene file
+  int depth = 1;              ///< number of hierarchy levels (1: a direct solve)
+  int max_attempts = 3;       ///< failed attempts allowed before the job stays failed
+};
+
+/// Where and with what a job ran (its latest attempt).
+struct Provenance {
+  std::string code_version;
+  std::string host;
+  std::optional<double> started_at;  ///< when the latest attempt was claimed
+  std::optional<double> ended_at;    ///< when the job last finished or failed
+};
+
+/// A job as stored. Times are seconds since the Unix epoch.
+struct Job {
+  std::string id;
+  nlohmann::json parameters;
+  std::string scene;
+  int depth = 1;
+  JobState state = JobState::queued;
+  /// Claims so far: the fencing token of the latest claim. Never decreases, not even on retry,
+  /// so a token handed out once is never valid again after a new claim.
+  std::int64_t attempt = 0;
+  std::int64_t failures = 0;  ///< failed attempts since the last retry
+  std::int64_t max_attempts = 1;
+  std::string lease_owner;  ///< worker holding the lease; empty unless running
+  std::optional<double> lease_expiry;
+  std::optional<double> heartbeat_at;
+  std::string error;  ///< the latest failure's message; empty if none (cleared when done)
+  Provenance provenance;
+  double created_at = 0;
+};
+
+/// Who claims: a worker's id (unique among live workers, e.g. host:pid), its host and the
+/// code version recorded as the job's provenance.
+struct WorkerInfo {
+  std::string id;
+  std::string host;
+  std::string code_version;
+};
+
+/// The right to write a job's results, valid while the job is running with this attempt.
+struct Lease {
+  std::string job_id;
+  std::int64_t attempt = 0;
+  double seconds = 0;  ///< how far each heartbeat pushes the expiry
+};
+
+/// A claimed job and the lease that must accompany every write about it.
+struct Claim {
+  Job job;
+  Lease lease;
+};
+
+/// The record of one hierarchy level of a job.
+struct LevelRecord {
+  int level = 0;  ///< 0 = coarsest; depth − 1 = finest
+  LevelStatus status = LevelStatus::running;
+  std::int64_t iterations = 0;
+  std::vector<double> residuals;         ///< per iteration (NaN allowed: stored as null)
+  std::map<std::string, double> timings;  ///< seconds per named phase
+  std::string checkpoint_path;            ///< empty if none
+  std::string checkpoint_checksum;        ///< of the checkpoint file; empty if none
+  std::string error;                      ///< empty unless failed
+  std::int64_t attempt = 0;  ///< the attempt that wrote it (set by the store on write)
+  double updated_at = 0;     ///< set by the store on write
+};
+
+/// What adding a sweep did (or, in a dry run, would do).
+struct SweepAddition {
+  std::vector<std::string> added;  ///< ids of the jobs that were new, in the sweep's order
+  std::int64_t already_present = 0;
+};
+
+/// Job counts of one sweep.
+struct SweepStatus {
+  std::string name;
+  std::string source;
+  double created_at = 0;
+  std::map<JobState, std::int64_t> counts;  ///< every state present, zeros included
+  std::int64_t expired_leases = 0;  ///< running jobs whose worker stopped heartbeating
+  std::int64_t total() const;
+};
+
+/// A job with its level records, coarsest first.
+struct JobResult {
+  Job job;
+  std::vector<LevelRecord> levels;
+};
+
+/// Which jobs an operation applies to.
+class JobSelection {
+ public:
+  static JobSelection all() { return JobSelection(Kind::all, {}); }
+  static JobSelection sweep(std::string name) { return JobSelection(Kind::sweep, std::move(name)); }
+  static JobSelection job(std::string id) { return JobSelection(Kind::job, std::move(id)); }
+
+  enum class Kind { all, sweep, job };
+  Kind kind() const { return kind_; }
+  /// The sweep name or job id (empty for all).
+  const std::string& name() const { return name_; }
+
+ private:
+  JobSelection(Kind kind, std::string name) : kind_(kind), name_(std::move(name)) {}
+  Kind kind_;
+  std::string name_;
+};
+
+}  // namespace psq::db

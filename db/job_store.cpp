@@ -1,0 +1,450 @@
+#include "db/job_store.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "db/schema.hpp"
+
+namespace psq::db {
+namespace {
+
+const std::filesystem::path& with_parent_directories(const std::filesystem::path& path) {
+  std::error_code failure;
+  if (const auto parent = path.parent_path(); !parent.empty()) {
+    std::filesystem::create_directories(parent, failure);
+    if (failure)
+      throw InputError(fmt::format("{}: cannot create the directory {} for the job store ({})",
+                                   path.string(), parent.string(), failure.message()));
+  }
+  return path;
+}
+
+/// WAL lets readers (status, reports) run beside one writer. synchronous=NORMAL syncs the WAL
+/// at checkpoints, not at every commit: a killed process loses nothing, and a power loss can
+/// only roll back the last commits, which the lease protocol absorbs (a job reverts to running
+/// and is rerun once its lease expires).
+void configure(SqliteConnection& connection) {
+  auto journal = connection.prepare("PRAGMA journal_mode = WAL");
+  if (!journal.step() || journal.text(0) != "wal")
+    throw InputError(fmt::format(
+        "{}: the job store needs SQLite's WAL mode, which this file system refused; keep the "
+        "database on a local disk",
+        connection.path().string()));
+  connection.execute("PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
+}
+
+constexpr const char* kJobColumns =
+    "jobs.id, jobs.parameters, jobs.scene, jobs.depth, jobs.state, jobs.attempt, jobs.failures, "
+    "jobs.max_attempts, jobs.lease_owner, jobs.lease_expiry, jobs.heartbeat_at, jobs.error, "
+    "jobs.code_version, jobs.host, jobs.started_at, jobs.ended_at, jobs.created_at";
+
+Job read_job(const Statement& row) {
+  Job job;
+  job.id = row.text(0);
+  job.parameters = nlohmann::json::parse(row.text(1));
+  job.scene = row.text(2);
+  job.depth = static_cast<int>(row.integer(3));
+  job.state = job_state_from_string(row.text(4));
+  job.attempt = row.integer(5);
+  job.failures = row.integer(6);
+  job.max_attempts = row.integer(7);
+  job.lease_owner = row.text(8);
+  job.lease_expiry = row.optional_real(9);
+  job.heartbeat_at = row.optional_real(10);
+  job.error = row.text(11);
+  job.provenance = {row.text(12), row.text(13), row.optional_real(14), row.optional_real(15)};
+  job.created_at = row.real(16);
+  return job;
+}
+
+constexpr const char* kLevelColumns =
+    "level, status, iterations, residuals, timings, checkpoint_path, checkpoint_checksum, "
+    "error, attempt, updated_at";
+
+/// Reads the level columns starting at column `first`.
+LevelRecord read_level(const Statement& row, int first) {
+  LevelRecord level;
+  level.level = static_cast<int>(row.integer(first));
+  level.status = level_status_from_string(row.text(first + 1));
+  level.iterations = row.integer(first + 2);
+  // JSON has no NaN or infinity: nlohmann writes them as null, read back as NaN.
+  for (const auto& residual : nlohmann::json::parse(row.text(first + 3)))
+    level.residuals.push_back(residual.is_number() ? residual.get<double>()
+                                                   : std::numeric_limits<double>::quiet_NaN());
+  const auto timings = nlohmann::json::parse(row.text(first + 4));
+  for (const auto& [phase, seconds] : timings.items())
+    level.timings[phase] = seconds.is_number() ? seconds.get<double>()
+                                               : std::numeric_limits<double>::quiet_NaN();
+  level.checkpoint_path = row.text(first + 5);
+  level.checkpoint_checksum = row.text(first + 6);
+  level.error = row.text(first + 7);
+  level.attempt = row.integer(first + 8);
+  level.updated_at = row.real(first + 9);
+  return level;
+}
+
+/// Empty text is stored as NULL.
+std::optional<std::string> unless_empty(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  return text;
+}
+
+/// SQL condition on `jobs` selecting `which`; its one parameter is ?1 (see selection_value).
+std::string selection_condition(const JobSelection& which) {
+  switch (which.kind()) {
+    case JobSelection::Kind::sweep:
+      return "jobs.id IN (SELECT sweep_jobs.job_id FROM sweep_jobs JOIN sweeps ON sweeps.id = "
+             "sweep_jobs.sweep_id WHERE sweeps.name = ?1)";
+    case JobSelection::Kind::job:
+      return "jobs.id = ?1";
+    case JobSelection::Kind::all:
+      break;
+  }
+  return "?1 IS NULL";
+}
+
+std::optional<std::string> selection_value(const JobSelection& which) {
+  if (which.kind() == JobSelection::Kind::all) return std::nullopt;
+  return which.name();
+}
+
+void validate_new_job(const std::string& sweep, const NewJob& job) {
+  const auto fail = [&](const std::string& problem) {
+    throw InputError(fmt::format("sweep '{}': job {}: {}", sweep, job.id, problem));
+  };
+  if (job.id.empty()) fail("empty job id (ids are hashes of the canonical parameters)");
+  if (job.depth < 1) fail(fmt::format("depth {} is not a number of levels; use 1 or more",
+                                      job.depth));
+  if (job.max_attempts < 1)
+    fail(fmt::format("max attempts {} must be at least 1", job.max_attempts));
+}
+
+}  // namespace
+
+JobStore::JobStore(const std::filesystem::path& path, JobStoreOptions options)
+    : options_(std::move(options)),
+      connection_(with_parent_directories(path), options_.busy_timeout_ms) {
+  configure(connection_);
+  migrate(connection_);
+}
+
+double JobStore::now() const {
+  if (options_.clock) return options_.clock();
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+SweepAddition JobStore::add_sweep(const std::string& name, const std::string& source,
+                                  const std::vector<NewJob>& jobs) {
+  return add_jobs(name, source, jobs, true);
+}
+
+SweepAddition JobStore::preview_sweep(const std::string& name, const std::vector<NewJob>& jobs) {
+  // The same code as add_sweep, rolled back: the preview cannot disagree with the real thing.
+  return add_jobs(name, "", jobs, false);
+}
+
+SweepAddition JobStore::add_jobs(const std::string& name, const std::string& source,
+                                 const std::vector<NewJob>& jobs, bool commit) {
+  if (name.empty()) throw InputError("a sweep needs a non-empty name");
+  for (const auto& job : jobs) validate_new_job(name, job);
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  const double time = now();
+  std::int64_t sweep_id = 0;
+  {
+    auto upsert = connection_.prepare(
+        "INSERT INTO sweeps (name, source, created_at) VALUES (?1, ?2, ?3) "
+        "ON CONFLICT (name) DO UPDATE SET source = excluded.source RETURNING id");
+    upsert.bind_all(name, source, time).step();
+    sweep_id = upsert.integer(0);
+  }
+  auto stored = connection_.prepare("SELECT parameters FROM jobs WHERE id = ?1");
+  auto insert = connection_.prepare(
+      "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+  auto link = connection_.prepare(
+      "INSERT OR IGNORE INTO sweep_jobs (sweep_id, job_id) VALUES (?1, ?2)");
+  SweepAddition addition;
+  for (const auto& job : jobs) {
+    const std::string parameters = job.parameters.dump();
+    if (stored.reset().bind_all(job.id).step()) {
+      if (stored.text(0) != parameters)
+        throw InputError(fmt::format(
+            "sweep '{}': job id {} is already stored with other parameters ({} instead of {}); "
+            "job ids must be hashes of the canonical parameters",
+            name, job.id, stored.text(0), parameters));
+      ++addition.already_present;
+    } else {
+      insert.reset().bind_all(job.id, parameters, job.scene, job.depth, job.max_attempts, time);
+      insert.run();
+      addition.added.push_back(job.id);
+    }
+    link.reset().bind_all(sweep_id, job.id).run();
+  }
+  if (commit) {
+    stored.reset();
+    transaction.commit();
+  }
+  return addition;
+}
+
+void JobStore::expire_leases(double time) {
+  connection_
+      .prepare(
+          "UPDATE jobs SET failures = failures + 1, "
+          "state = CASE WHEN failures + 1 >= max_attempts THEN 'failed' ELSE 'queued' END, "
+          "ended_at = CASE WHEN failures + 1 >= max_attempts THEN ?1 ELSE ended_at END, "
+          "error = printf('attempt %d by worker %s stopped sending heartbeats (last at %s UTC) "
+          "and its lease expired', attempt, lease_owner, "
+          "strftime('%Y-%m-%d %H:%M:%S', heartbeat_at, 'unixepoch')), "
+          "lease_owner = NULL, lease_expiry = NULL "
+          "WHERE state = 'running' AND lease_expiry <= ?1")
+      .bind_all(time)
+      .run();
+}
+
+std::optional<Claim> JobStore::claim_next(const WorkerInfo& worker, double lease_seconds) {
+  if (worker.id.empty()) throw std::invalid_argument("claim_next: empty worker id");
+  if (!(lease_seconds > 0))
+    throw std::invalid_argument(fmt::format("claim_next: lease of {} s", lease_seconds));
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  const double time = now();
+  expire_leases(time);
+  std::string id;
+  {
+    auto next = connection_.prepare(
+        "SELECT id FROM jobs WHERE state = 'queued' ORDER BY number LIMIT 1");
+    if (!next.step()) {
+      next.reset();
+      transaction.commit();
+      return std::nullopt;
+    }
+    id = next.text(0);
+  }
+  if (options_.inside_claim_transaction) options_.inside_claim_transaction();
+  connection_
+      .prepare(
+          "UPDATE jobs SET state = 'running', attempt = attempt + 1, lease_owner = ?2, "
+          "lease_expiry = ?3, heartbeat_at = ?4, host = ?5, code_version = ?6, started_at = ?4, "
+          "ended_at = NULL WHERE id = ?1")
+      .bind_all(id, worker.id, time + lease_seconds, time, worker.host, worker.code_version)
+      .run();
+  auto claimed = jobs_where("1", JobSelection::job(id));
+  transaction.commit();
+  Job& job = claimed.front();
+  Lease lease{job.id, job.attempt, lease_seconds};
+  return Claim{std::move(job), std::move(lease)};
+}
+
+bool JobStore::heartbeat(const Lease& lease) {
+  const double time = now();
+  return connection_
+             .prepare(
+                 "UPDATE jobs SET lease_expiry = ?3, heartbeat_at = ?4 "
+                 "WHERE id = ?1 AND attempt = ?2 AND state = 'running'")
+             .bind_all(lease.job_id, lease.attempt, time + lease.seconds, time)
+             .run() == 1;
+}
+
+int JobStore::check_lease(const Lease& lease) {
+  auto job = connection_.prepare("SELECT state, attempt, depth FROM jobs WHERE id = ?1");
+  if (!job.bind_all(lease.job_id).step())
+    throw LeaseLostError(fmt::format("job {} is not in {}; the write was refused", lease.job_id,
+                                     path().string()));
+  if (job.text(0) != to_string(JobState::running) || job.integer(1) != lease.attempt)
+    throw LeaseLostError(fmt::format(
+        "job {}: attempt {} no longer holds the lease (the job is {} at attempt {}); the write "
+        "was refused",
+        lease.job_id, lease.attempt, job.text(0), job.integer(1)));
+  return static_cast<int>(job.integer(2));
+}
+
+void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  const int depth = check_lease(lease);
+  if (level.level < 0 || level.level >= depth)
+    throw std::invalid_argument(fmt::format("job {}: level {} outside [0, {})", lease.job_id,
+                                            level.level, depth));
+  nlohmann::json timings = nlohmann::json::object();
+  for (const auto& [phase, seconds] : level.timings) timings[phase] = seconds;
+  connection_
+      .prepare(
+          "REPLACE INTO levels (job_id, level, status, iterations, residuals, timings, "
+          "checkpoint_path, checkpoint_checksum, error, attempt, updated_at) "
+          "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)")
+      .bind_all(lease.job_id, level.level, to_string(level.status), level.iterations,
+                nlohmann::json(level.residuals).dump(), timings.dump(),
+                unless_empty(level.checkpoint_path), unless_empty(level.checkpoint_checksum),
+                unless_empty(level.error), lease.attempt, now())
+      .run();
+  transaction.commit();
+}
+
+void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& error) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_lease(lease);
+  if (outcome == Outcome::done) {
+    connection_
+        .prepare(
+            "UPDATE jobs SET state = 'done', error = NULL, lease_owner = NULL, "
+            "lease_expiry = NULL, ended_at = ?2 WHERE id = ?1")
+        .bind_all(lease.job_id, now())
+        .run();
+  } else {
+    const int permanent = outcome == Outcome::failed_permanently;
+    connection_
+        .prepare(
+            "UPDATE jobs SET failures = failures + 1, state = CASE WHEN ?4 OR failures + 1 >= "
+            "max_attempts THEN 'failed' ELSE 'queued' END, error = ?3, lease_owner = NULL, "
+            "lease_expiry = NULL, ended_at = ?2 WHERE id = ?1")
+        .bind_all(lease.job_id, now(), unless_empty(error), permanent)
+        .run();
+  }
+  transaction.commit();
+}
+
+bool JobStore::release(const Lease& lease) {
+  return connection_
+             .prepare(
+                 "UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
+                 "WHERE id = ?1 AND attempt = ?2 AND state = 'running'")
+             .bind_all(lease.job_id, lease.attempt)
+             .run() == 1;
+}
+
+void JobStore::check_selection_exists(const JobSelection& which) {
+  if (which.kind() == JobSelection::Kind::all) return;
+  const bool is_sweep = which.kind() == JobSelection::Kind::sweep;
+  auto found = connection_.prepare(is_sweep ? "SELECT 1 FROM sweeps WHERE name = ?1"
+                                            : "SELECT 1 FROM jobs WHERE id = ?1");
+  if (found.bind_all(which.name()).step()) return;
+  if (!is_sweep)
+    throw InputError(fmt::format("{}: no job with id {}", path().string(), which.name()));
+  std::vector<std::string> names;
+  auto sweeps = connection_.prepare("SELECT name FROM sweeps ORDER BY id");
+  while (sweeps.step()) names.push_back(sweeps.text(0));
+  if (names.empty()) names.push_back("no sweeps");
+  throw InputError(fmt::format("{}: no sweep named '{}' (the store has: {})", path().string(),
+                               which.name(), fmt::join(names, ", ")));
+}
+
+std::int64_t JobStore::cancel(const JobSelection& which) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_selection_exists(which);
+  const auto cancelled =
+      connection_
+          .prepare("UPDATE jobs SET state = 'cancelled', lease_owner = NULL, lease_expiry = NULL, "
+                   "ended_at = ?2 WHERE state IN ('queued', 'running') AND " +
+                   selection_condition(which))
+          .bind_all(selection_value(which), now())
+          .run();
+  transaction.commit();
+  return cancelled;
+}
+
+std::int64_t JobStore::retry(const JobSelection& which, bool include_cancelled) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_selection_exists(which);
+  const std::string states = include_cancelled ? "('failed', 'cancelled')" : "('failed')";
+  const auto requeued =
+      connection_
+          .prepare("UPDATE jobs SET state = 'queued', failures = 0, error = NULL, ended_at = NULL "
+                   "WHERE state IN " + states + " AND " + selection_condition(which))
+          .bind_all(selection_value(which))
+          .run();
+  transaction.commit();
+  return requeued;
+}
+
+std::vector<SweepStatus> JobStore::status() {
+  auto rows = connection_.prepare(
+      "SELECT sweeps.name, sweeps.source, sweeps.created_at, jobs.state, COUNT(jobs.id), "
+      "COALESCE(SUM(jobs.state = 'running' AND jobs.lease_expiry <= ?1), 0) "
+      "FROM sweeps LEFT JOIN sweep_jobs ON sweep_jobs.sweep_id = sweeps.id "
+      "LEFT JOIN jobs ON jobs.id = sweep_jobs.job_id "
+      "GROUP BY sweeps.id, jobs.state ORDER BY sweeps.id");
+  rows.bind_all(now());
+  std::vector<SweepStatus> sweeps;
+  while (rows.step()) {
+    if (sweeps.empty() || sweeps.back().name != rows.text(0)) {
+      SweepStatus& sweep = sweeps.emplace_back();
+      sweep.name = rows.text(0);
+      sweep.source = rows.text(1);
+      sweep.created_at = rows.real(2);
+      for (const JobState state : kAllJobStates) sweep.counts[state] = 0;
+    }
+    if (rows.is_null(3)) continue;  // a sweep without jobs
+    sweeps.back().counts[job_state_from_string(rows.text(3))] = rows.integer(4);
+    sweeps.back().expired_leases += rows.integer(5);
+  }
+  return sweeps;
+}
+
+SweepStatus JobStore::status(const std::string& sweep) {
+  check_selection_exists(JobSelection::sweep(sweep));
+  for (auto& counted : status())
+    if (counted.name == sweep) return counted;
+  throw InputError(fmt::format("{}: no sweep named '{}'", path().string(), sweep));
+}
+
+std::vector<Job> JobStore::jobs_where(const std::string& condition, const JobSelection& which) {
+  auto rows = connection_.prepare(fmt::format("SELECT {} FROM jobs WHERE {} AND ({}) ORDER BY "
+                                              "jobs.number",
+                                              kJobColumns, selection_condition(which), condition));
+  rows.bind_all(selection_value(which));
+  std::vector<Job> jobs;
+  while (rows.step()) jobs.push_back(read_job(rows));
+  return jobs;
+}
+
+std::vector<Job> JobStore::failures(const JobSelection& which) {
+  Transaction snapshot(connection_, Transaction::Mode::deferred);
+  check_selection_exists(which);
+  return jobs_where("jobs.error IS NOT NULL OR jobs.state = 'failed'", which);
+}
+
+std::vector<JobResult> JobStore::results(const JobSelection& which) {
+  // One read transaction: the jobs and their levels come from the same snapshot.
+  Transaction snapshot(connection_, Transaction::Mode::deferred);
+  check_selection_exists(which);
+  std::vector<JobResult> results;
+  std::map<std::string, std::size_t> index_of;
+  for (auto& job : jobs_where("1", which)) {
+    index_of[job.id] = results.size();
+    results.push_back({std::move(job), {}});
+  }
+  auto levels = connection_.prepare(fmt::format(
+      "SELECT job_id, {} FROM levels WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) "
+      "ORDER BY job_id, level",
+      kLevelColumns, selection_condition(which)));
+  levels.bind_all(selection_value(which));
+  while (levels.step())
+    results[index_of.at(levels.text(0))].levels.push_back(read_level(levels, 1));
+  return results;
+}
+
+std::optional<Job> JobStore::find_job(const std::string& id) {
+  auto found = jobs_where("1", JobSelection::job(id));
+  if (found.empty()) return std::nullopt;
+  return std::move(found.front());
+}
+
+std::vector<std::string> JobStore::integrity_problems() {
+  std::vector<std::string> problems;
+  auto integrity = connection_.prepare("PRAGMA integrity_check");
+  while (integrity.step())
+    if (integrity.text(0) != "ok") problems.push_back(integrity.text(0));
+  auto foreign_keys = connection_.prepare("PRAGMA foreign_key_check");
+  while (foreign_keys.step())
+    problems.push_back(fmt::format("row {} of {} refers to a missing row of {}",
+                                   foreign_keys.integer(1), foreign_keys.text(0),
+                                   foreign_keys.text(2)));
+  return problems;
+}
+
+}  // namespace psq::db

@@ -1,0 +1,111 @@
+#pragma once
+// The SQLite job store: sweeps, jobs with leases, per-level records. Several worker processes
+// share one store on local disk. Every write is one short transaction; claims run inside
+// BEGIN IMMEDIATE; every write about a claimed job carries its Lease, whose attempt number is a
+// fencing token: once the job has been claimed again (or cancelled, finished, released), a
+// late write from the old attempt is refused and changes nothing. docs/job-store.md has the
+// whole protocol.
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "db/job_records.hpp"
+#include "db/sqlite_handle.hpp"
+
+namespace psq::db {
+
+/// A write about a job whose lease this attempt no longer holds: the job was claimed again
+/// after the lease expired, cancelled, finished or released. The worker must stop the job.
+class LeaseLostError : public Error {
+ public:
+  using Error::Error;
+};
+
+struct JobStoreOptions {
+  /// How long a statement waits for another process's write lock before failing.
+  int busy_timeout_ms = 10'000;
+  /// Seconds since the Unix epoch; the system clock when empty. Tests move time by hand.
+  std::function<double()> clock;
+  /// Test seam: called inside claim_next's transaction, after the job is chosen and before the
+  /// claim is committed (to kill a process while it holds the write lock).
+  std::function<void()> inside_claim_transaction;
+};
+
+/// One connection to a job store. Not thread-safe: use one JobStore per thread (e.g. a second
+/// one for a heartbeat thread), and open a new one after fork().
+class JobStore {
+ public:
+  /// Opens the store at `path`, creating it and its parent directories if needed, in WAL mode
+  /// with synchronous=NORMAL, foreign keys on, and migrations applied. Throws InputError naming
+  /// the file if it is not a SQLite database, belongs to another program, or has a newer
+  /// schema than this build.
+  explicit JobStore(const std::filesystem::path& path, JobStoreOptions options = {});
+
+  const std::filesystem::path& path() const { return connection_.path(); }
+
+  /// Adds the sweep `name` (or extends it) with the jobs whose ids are not yet stored; jobs
+  /// already stored (by this or another sweep) are only linked to it and keep their state.
+  /// Throws InputError if a job is invalid or an id is stored with other parameters.
+  SweepAddition add_sweep(const std::string& name, const std::string& source,
+                          const std::vector<NewJob>& jobs);
+  /// What add_sweep would do, without changing anything.
+  SweepAddition preview_sweep(const std::string& name, const std::vector<NewJob>& jobs);
+
+  /// Claims the first queued job (in the order jobs were added) for `worker`, with a lease of
+  /// `lease_seconds`. Running jobs whose lease expired are first put back in the queue with
+  /// one more failure (or failed, if that was their last attempt). Returns nothing when no
+  /// job is queued.
+  std::optional<Claim> claim_next(const WorkerInfo& worker, double lease_seconds);
+  /// Pushes the lease expiry to now + lease.seconds. False if the lease is lost (the worker
+  /// must stop the job; its writes would be refused).
+  [[nodiscard]] bool heartbeat(const Lease& lease);
+  /// Stores (or replaces) the record of one level. Throws LeaseLostError if the lease is lost,
+  /// std::invalid_argument if the level is outside [0, depth).
+  void record_level(const Lease& lease, const LevelRecord& level);
+  /// Ends the attempt: done, or failed with `error` (queued again while failures stay below
+  /// max_attempts, unless permanent). Throws LeaseLostError if the lease is lost.
+  void finish(const Lease& lease, Outcome outcome, const std::string& error = {});
+  /// Gives the job back to the queue without counting a failure (clean shutdown). False if
+  /// the lease was already lost.
+  bool release(const Lease& lease);
+
+  /// Cancels the selected queued or running jobs; returns how many. A running job's worker
+  /// learns it from its next heartbeat.
+  std::int64_t cancel(const JobSelection& which);
+  /// Puts the selected failed jobs (and cancelled ones, if `include_cancelled`) back in the
+  /// queue with their failure count reset; returns how many.
+  std::int64_t retry(const JobSelection& which, bool include_cancelled = false);
+
+  /// Counts per state of every sweep, in the order sweeps were created.
+  std::vector<SweepStatus> status();
+  /// Counts per state of one sweep. Throws InputError for an unknown sweep.
+  SweepStatus status(const std::string& sweep);
+  /// The selected jobs that have a failure message (failed ones, and ones waiting for a retry).
+  std::vector<Job> failures(const JobSelection& which);
+  /// The selected jobs with their level records, in the order jobs were added.
+  std::vector<JobResult> results(const JobSelection& which);
+  /// The job with this id, if stored.
+  std::optional<Job> find_job(const std::string& id);
+  /// Result of SQLite's integrity check: empty if the database is sound, else the problems.
+  std::vector<std::string> integrity_problems();
+
+ private:
+  SweepAddition add_jobs(const std::string& name, const std::string& source,
+                         const std::vector<NewJob>& jobs, bool commit);
+  void expire_leases(double time);
+  /// Throws LeaseLostError unless the job is running with the lease's attempt; returns its
+  /// depth.
+  int check_lease(const Lease& lease);
+  /// Throws InputError if the selection names a sweep or job that is not stored.
+  void check_selection_exists(const JobSelection& which);
+  std::vector<Job> jobs_where(const std::string& condition, const JobSelection& which);
+  double now() const;
+
+  JobStoreOptions options_;
+  SqliteConnection connection_;
+};
+
+}  // namespace psq::db

@@ -1,0 +1,146 @@
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "db/job_store.hpp"
+#include "db/schema.hpp"
+#include "store_fixtures.hpp"
+#include "support/test_paths.hpp"
+
+namespace psq::db {
+namespace {
+
+std::string single_text(SqliteConnection& connection, const std::string& sql) {
+  auto query = connection.prepare(sql);
+  EXPECT_TRUE(query.step()) << sql;
+  return query.text(0);
+}
+
+std::int64_t single_integer(SqliteConnection& connection, const std::string& sql) {
+  auto query = connection.prepare(sql);
+  EXPECT_TRUE(query.step()) << sql;
+  return query.integer(0);
+}
+
+/// The message of the InputError that `open` throws; fails the test if it throws nothing.
+template <class Open>
+std::string input_error_of(Open open) {
+  try {
+    open();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return {};
+}
+
+TEST(JobStoreSchema, FreshStoreIsCreatedWithParentsInWalModeAtTheLatestVersion) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "nested" / ".psq" / "psq.db";
+  { JobStore store(path); }
+  ASSERT_TRUE(std::filesystem::exists(path));
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(single_text(raw, "PRAGMA journal_mode"), "wal");  // persistent in the file
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM schema_version"), latest_schema_version());
+  for (const char* table : {"sweeps", "jobs", "sweep_jobs", "levels"})
+    EXPECT_EQ(single_integer(raw, fmt::format("SELECT COUNT(*) FROM sqlite_schema WHERE "
+                                              "type = 'table' AND name = '{}'", table)),
+              1)
+        << table;
+  // The claim query must be served by an index, not a scan of every job.
+  auto explain = raw.prepare(
+      "EXPLAIN QUERY PLAN SELECT id FROM jobs WHERE state = 'queued' ORDER BY number LIMIT 1");
+  std::string details;
+  while (explain.step()) details += explain.text(3) + "\n";
+  EXPECT_NE(details.find("USING INDEX jobs_by_state"), std::string::npos) << details;
+  EXPECT_EQ(details.find("TEMP B-TREE"), std::string::npos) << details;
+}
+
+TEST(JobStoreSchema, ReopeningKeepsDataAndAppliesNothingTwice) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    store.add_sweep("s", "s.toml", test::thickness_jobs(0, 3));
+  }
+  std::string schema_before;
+  {
+    SqliteConnection raw(path, 1000);
+    schema_before = single_text(raw, "SELECT group_concat(sql, ';') FROM sqlite_schema");
+  }
+  JobStore reopened(path);
+  EXPECT_EQ(reopened.status("s").total(), 3);
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM schema_version"), latest_schema_version());
+  EXPECT_EQ(single_text(raw, "SELECT group_concat(sql, ';') FROM sqlite_schema"), schema_before);
+}
+
+TEST(JobStoreSchema, NewerSchemaIsRefusedWithUpgradeAdvice) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  { JobStore store(path); }
+  const int future = latest_schema_version() + 6;
+  {
+    SqliteConnection raw(path, 1000);
+    raw.prepare("INSERT INTO schema_version (version, description) VALUES (?1, 'future')")
+        .bind_all(future)
+        .run();
+  }
+  const std::string message = input_error_of([&] { JobStore store(path); });
+  EXPECT_EQ(message, fmt::format("{} has schema version {} but this psq understands up to {}; "
+                                 "upgrade psq",
+                                 path.string(), future, latest_schema_version()));
+}
+
+TEST(JobStoreSchema, FileThatIsNotADatabaseIsRefusedByName) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  std::string text;
+  for (int i = 0; i < 200; ++i) text += "this is a sweep file, not a database\n";
+  psq::test::write_file(path, text);
+  const std::string message = input_error_of([&] { JobStore store(path); });
+  EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("not a SQLite database"), std::string::npos) << message;
+  // Refusing must not have damaged the file.
+  std::ifstream in(path);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), text);
+}
+
+TEST(JobStoreSchema, SqliteDatabaseOfAnotherProgramIsRefused) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "other.db";
+  {
+    SqliteConnection raw(path, 1000);
+    raw.execute("CREATE TABLE photos (id INTEGER PRIMARY KEY, file TEXT)");
+  }
+  const std::string message = input_error_of([&] { JobStore store(path); });
+  EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("not a psq job store"), std::string::npos) << message;
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sqlite_schema WHERE type = 'table'"), 1);
+}
+
+TEST(JobStoreSchema, UncreatableDirectoryIsReportedWithThePath) {
+  const auto dir = psq::test::fresh_temp_dir("db-schema");
+  psq::test::write_file(dir / "plain-file", "x");
+  const auto path = dir / "plain-file" / "sub" / "psq.db";
+  const std::string message = input_error_of([&] { JobStore store(path); });
+  EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("cannot create the directory"), std::string::npos) << message;
+}
+
+TEST(JobStoreSchema, SqlErrorsNameTheStatementAndTheDatabase) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  SqliteConnection raw(path, 1000);
+  try {
+    raw.execute("SELECT no_such_column FROM no_such_table");
+    FAIL() << "expected DatabaseError";
+  } catch (const DatabaseError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("no_such_table"), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace psq::db
