@@ -1,0 +1,27 @@
+#pragma once
+// 64-bit FNV-1a: a fast, dependency-free checksum for detecting damaged or modified files.
+// Not cryptographic; every single-byte change alters it (each step is a bijection of the state).
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace psq {
+
+/// Incremental 64-bit FNV-1a: for each byte b, h = (h ⊕ b) · 1099511628211, starting from
+/// h = 14695981039346656037 (Fowler–Noll–Vo, the published 64-bit parameters).
+class Fnv1a64 {
+ public:
+  Fnv1a64& update(std::span<const std::byte> bytes);
+  Fnv1a64& update(std::string_view text) { return update(std::as_bytes(std::span(text))); }
+  [[nodiscard]] std::uint64_t value() const { return state_; }
+
+ private:
+  std::uint64_t state_ = 14695981039346656037ull;
+};
+
+/// FNV-1a 64 of a byte sequence in one call.
+[[nodiscard]] std::uint64_t fnv1a64(std::span<const std::byte> bytes);
+
+}  // namespace psq

@@ -1,0 +1,38 @@
+#include <gtest/gtest.h>
+
+#include <string_view>
+
+#include "engine/io/checksum.hpp"
+
+namespace psq {
+namespace {
+
+std::uint64_t fnv_of(std::string_view text) { return fnv1a64(std::as_bytes(std::span(text))); }
+
+// Reference values published with the FNV algorithm (64-bit FNV-1a test vectors).
+TEST(Fnv1a64, MatchesPublishedTestVectors) {
+  EXPECT_EQ(fnv_of(""), 0xcbf29ce484222325ull);
+  EXPECT_EQ(fnv_of("a"), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(fnv_of("foobar"), 0x85944171f73967e8ull);
+}
+
+TEST(Fnv1a64, IncrementalUpdatesEqualOneCall) {
+  Fnv1a64 hash;
+  hash.update("foo").update("").update("bar");
+  EXPECT_EQ(hash.value(), fnv_of("foobar"));
+}
+
+TEST(Fnv1a64, EverySingleByteChangeIsDetected) {
+  const std::string original = "checkpoint bytes \x01\x02\x03";
+  const std::uint64_t reference = fnv_of(original);
+  for (std::size_t i = 0; i < original.size(); ++i) {
+    for (int bit = 0; bit < 8; ++bit) {
+      std::string changed = original;
+      changed[i] = static_cast<char>(changed[i] ^ (1 << bit));
+      EXPECT_NE(fnv_of(changed), reference) << "byte " << i << " bit " << bit;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace psq
