@@ -1,0 +1,39 @@
+#pragma once
+// Squared distance between two edges, with its gradient and Hessian over the 4-vertex stencil
+// (ea0, ea1, eb0, eb1), whatever the closest features (parallel edges included).
+
+#include <Eigen/Core>
+
+#include "engine/contact/distance_type.hpp"
+
+namespace psq {
+
+/// Squared distance between the LINES through the edges: d = (n·(ea0 − eb0))²/‖n‖² with
+/// n = u × v, u = ea1 − ea0, v = eb1 − eb0. The lines must not be parallel.
+double line_line_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                          const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1);
+
+/// line_line_distance with its derivatives over (ea0, ea1, eb0, eb1). The closest points are
+/// ea0 + s u and eb0 + t v with s = n·(v × w₀)/‖n‖², t = n·(u × w₀)/‖n‖², w₀ = ea0 − eb0;
+/// with the weights w = (1 − s, s, t − 1, −t) and q = n (n·w₀)/‖n‖²,
+///   ∇d = 2 w ⊗ q,   ∇²d = 2 (w wᵀ) ⊗ I₃ − 2 Bᵀ G⁻¹ B
+/// (closest_pair_distance_derivatives with the parameters s, t; G is the Gram matrix of
+/// u, −v, det G = ‖n‖²).
+StencilDerivatives<12> line_line_distance_derivatives(const Eigen::Vector3d& ea0,
+                                                      const Eigen::Vector3d& ea1,
+                                                      const Eigen::Vector3d& eb0,
+                                                      const Eigen::Vector3d& eb1);
+
+/// Squared distance between the edges (ea0, ea1) and (eb0, eb1), by edge_edge_case: a
+/// point–point, point–line or line–line distance.
+double edge_edge_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                          const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1);
+
+/// edge_edge_distance with its derivatives over (ea0, ea1, eb0, eb1), zero for the vertices
+/// the closest features do not involve.
+StencilDerivatives<12> edge_edge_distance_derivatives(const Eigen::Vector3d& ea0,
+                                                      const Eigen::Vector3d& ea1,
+                                                      const Eigen::Vector3d& eb0,
+                                                      const Eigen::Vector3d& eb1);
+
+}  // namespace psq
