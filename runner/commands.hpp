@@ -18,5 +18,7 @@ struct Command {
 
 /// Each adds one subcommand to `app` and its runner to `commands`.
 void register_sim_command(CLI::App& app, std::vector<Command>& commands);
+void register_check_command(CLI::App& app, std::vector<Command>& commands);
+void register_ccd_bench_command(CLI::App& app, std::vector<Command>& commands);
 
 }  // namespace psq::runner

@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<psq::runner::Command> commands;
   psq::runner::register_sim_command(app, commands);
+  psq::runner::register_check_command(app, commands);
+  psq::runner::register_ccd_bench_command(app, commands);
   try {
     app.parse(argc, argv);
     for (const auto& command : commands)
