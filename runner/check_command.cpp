@@ -12,6 +12,7 @@
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "runner/commands.hpp"
+#include "runner/shell_parts.hpp"
 
 namespace psq::runner {
 namespace {
@@ -19,14 +20,6 @@ namespace {
 struct CheckOptions {
   std::string scene;
 };
-
-std::vector<TrianglePart> shell_parts(const ShellSystem& system) {
-  std::vector<TrianglePart> parts;
-  for (const ShellBlock& shell : system.shells())
-    parts.push_back(
-        {fmt::format("shell '{}'", shell.name), shell.first_triangle, shell.triangle_count});
-  return parts;
-}
 
 int run_check(const CheckOptions& options) {
   const Scene scene = read_scene(options.scene);

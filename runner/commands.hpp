@@ -20,5 +20,7 @@ struct Command {
 void register_sim_command(CLI::App& app, std::vector<Command>& commands);
 void register_check_command(CLI::App& app, std::vector<Command>& commands);
 void register_ccd_bench_command(CLI::App& app, std::vector<Command>& commands);
+void register_sweep_command(CLI::App& app, std::vector<Command>& commands);
+void register_status_command(CLI::App& app, std::vector<Command>& commands);
 
 }  // namespace psq::runner

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   psq::runner::register_sim_command(app, commands);
   psq::runner::register_check_command(app, commands);
   psq::runner::register_ccd_bench_command(app, commands);
+  psq::runner::register_sweep_command(app, commands);
+  psq::runner::register_status_command(app, commands);
   try {
     app.parse(argc, argv);
     for (const auto& command : commands)

@@ -6,12 +6,14 @@
 #include <unistd.h>
 
 #include "engine/core/atomic_file.hpp"
+#include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "runner/commands.hpp"
 #include "runner/output_dir.hpp"
+#include "runner/shell_parts.hpp"
 #include "runner/stats_json.hpp"
 
 namespace psq::runner {
@@ -29,11 +31,12 @@ void write_frame(const std::filesystem::path& dir, int frame, const TriMesh& res
 
 int run_sim(const SimOptions& sim_options) {
   const Scene scene = read_scene(sim_options.scene);
-  const std::filesystem::path out = prepare_output_dir(sim_options.out);
-  const bool terminal = ::isatty(STDERR_FILENO);
-
   QuasistaticSimulation sim(scene);
   const TriMesh& rest = sim.system().rest_mesh();
+  require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
+                            shell_parts(sim.system()));
+  const std::filesystem::path out = prepare_output_dir(sim_options.out);
+  const bool terminal = ::isatty(STDERR_FILENO);
   std::cerr << fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, tolerance {:.3g} m/s\n",
                            scene.name, rest.vertex_count(), rest.triangle_count(), sim.frame_count(),
                            sim.newton_settings().tolerance);

@@ -49,6 +49,18 @@ TEST(CheckCommand, CrossingShellsAreListedByShellAndTriangleAndExitOne) {
   EXPECT_NE(result.errors.find("not free of intersections"), std::string::npos) << result.errors;
 }
 
+TEST(CheckCommand, SimRefusesToStartFromAnIntersectingStateAndWritesNothing) {
+  const auto dir = test::fresh_temp_dir("check");
+  const auto scene = test::write_file(dir / "crossing.toml", floor_and_wall(0.05));
+  const auto result = test::run_psq({"sim", scene.string(), "--out", (dir / "out").string()});
+  EXPECT_EQ(result.exit_code, 1) << result.errors;
+  EXPECT_NE(result.errors.find("crossing.toml: initial state"), std::string::npos) << result.errors;
+  EXPECT_NE(result.errors.find("shell 'floor' triangle 2 and shell 'wall' triangle 0"),
+            std::string::npos)
+      << result.errors;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
 TEST(CheckCommand, ShellsApartPass) {
   const auto dir = test::fresh_temp_dir("check");
   const auto scene = test::write_file(dir / "apart.toml", floor_and_wall(0.2));

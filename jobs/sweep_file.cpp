@@ -1,0 +1,294 @@
+#include "jobs/sweep_file.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "engine/core/error.hpp"
+#include "engine/scene/key_suggestion.hpp"
+#include "engine/scene/scene_reader.hpp"
+#include "jobs/scene_overrides.hpp"
+
+namespace psq::jobs {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kDepth = "depth";
+
+long line_of(const toml::node& node) { return static_cast<long>(node.source().begin.line); }
+
+/// A value as written in the sweep file, with its line.
+struct Value {
+  nlohmann::json raw;
+  long line = 0;
+};
+
+/// Parameters varied together: one path for a [grid] list, several for a [[zip]] group.
+/// columns[p][i] is the i-th value of paths[p]; every column has the same length.
+struct Axis {
+  std::vector<std::string> paths;
+  std::vector<std::vector<Value>> columns;
+  std::size_t size() const { return columns.front().size(); }
+};
+
+/// Reads a sweep file's TOML and raises located InputErrors about it.
+class SweepReader {
+ public:
+  explicit SweepReader(fs::path file) : file_(std::move(file)), document_(parse()) {}
+
+  Sweep read() {
+    allow_only(document_, {"name", "scene", kDepth, "grid", "zip"}, "at the top level");
+    Sweep sweep;
+    sweep.file = file_;
+    sweep.name = required_string("name");
+    sweep.scene = scene_path();
+    sweep.scene_hash = file_content_hash(sweep.scene);
+    const Scene base = read_scene(sweep.scene);
+    const std::vector<Axis> axes = read_axes(base);
+    const Value depth = default_depth(axes);
+    std::map<std::string, std::size_t> index_of_id;
+    for_each_combination(axes, [&](const std::vector<std::size_t>& pick) {
+      SweepJob job = make_job(base, sweep.scene_hash, axes, pick, depth);
+      const auto [it, inserted] = index_of_id.emplace(job.id, sweep.jobs.size());
+      if (!inserted)
+        fail(0, fmt::format("jobs {} and {} have the same parameters ({}); a value is listed twice",
+                            it->second + 1, sweep.jobs.size() + 1, describe_parameters(job)));
+      sweep.jobs.push_back(std::move(job));
+    });
+    return sweep;
+  }
+
+ private:
+  [[noreturn]] void fail(long line, const std::string& message) const {
+    throw InputError(located_message(file_.string(), line, message));
+  }
+
+  toml::table parse() const {
+    std::ifstream in(file_, std::ios::binary);
+    if (!in) fail(0, "cannot open the sweep file");
+    std::stringstream text;
+    text << in.rdbuf();
+    try {
+      return toml::parse(text.str(), file_.string());
+    } catch (const toml::parse_error& error) {
+      fail(line_of_error(error), fmt::format("TOML syntax error: {}", error.description()));
+    }
+  }
+
+  static long line_of_error(const toml::parse_error& error) {
+    return static_cast<long>(error.source().begin.line);
+  }
+
+  /// Rejects the first key of `table` (in file order) not in `allowed`, suggesting the nearest.
+  void allow_only(const toml::table& table, const std::vector<std::string>& allowed,
+                  const std::string& where) const {
+    const toml::key* unknown = nullptr;
+    for (auto&& [key, value] : table) {
+      if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
+      if (!unknown || key.source().begin.line < unknown->source().begin.line) unknown = &key;
+    }
+    if (!unknown) return;
+    const auto suggestion = suggest_key(unknown->str(), allowed);
+    fail(static_cast<long>(unknown->source().begin.line),
+         fmt::format("unknown key '{}' {}; {}", unknown->str(), where,
+                     suggestion ? fmt::format("did you mean '{}'?", *suggestion)
+                                : fmt::format("valid keys: {}", fmt::join(allowed, ", "))));
+  }
+
+  std::string required_string(const std::string& key) const {
+    const toml::node* node = document_.get(key);
+    if (!node) fail(0, fmt::format("missing '{}' at the top level", key));
+    const auto value = node->value<std::string>();
+    if (!node->is_string() || value->empty())
+      fail(line_of(*node), fmt::format("'{}' must be a non-empty string", key));
+    return *value;
+  }
+
+  /// The base scene, relative to the sweep file's directory.
+  fs::path scene_path() const {
+    const fs::path scene = (file_.parent_path() / required_string("scene")).lexically_normal();
+    if (!fs::is_regular_file(scene))
+      fail(line_of(*document_.get("scene")),
+           fmt::format("scene file '{}' does not exist", scene.string()));
+    return scene;
+  }
+
+  static nlohmann::json scalar_json(const toml::node& node) {
+    if (const auto* integer = node.as_integer()) return integer->get();
+    if (const auto* real = node.as_floating_point()) return real->get();
+    if (const auto* boolean = node.as_boolean()) return boolean->get();
+    if (const auto* text = node.as_string()) return text->get();
+    return nullptr;
+  }
+
+  /// The values of the list at `path` ("'path' in [grid]" in messages).
+  std::vector<Value> read_list(const std::string& path, const toml::node& node,
+                               const std::string& where) const {
+    const toml::array* list = node.as_array();
+    if (!list || list->empty())
+      fail(line_of(node),
+           fmt::format("'{}' {} must be a non-empty list of values, e.g. [1, 2]", path, where));
+    std::vector<Value> values;
+    for (const toml::node& element : *list) {
+      nlohmann::json value = scalar_json(element);
+      if (value.is_null())
+        fail(line_of(element), fmt::format("'{}' {} must list numbers, not arrays or tables",
+                                           path, where));
+      values.push_back({std::move(value), line_of(element)});
+    }
+    return values;
+  }
+
+  /// Every list in `table` by dotted path: `a.b = [..]` and `"a.b" = [..]` are the same path.
+  void collect_lists(const toml::table& table, const std::string& prefix, const std::string& where,
+                     std::vector<std::pair<std::string, std::vector<Value>>>& lists) const {
+    for (auto&& [key, node] : table) {
+      const std::string path = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+      if (const toml::table* nested = node.as_table())
+        collect_lists(*nested, path, where, lists);
+      else
+        lists.emplace_back(path, read_list(path, node, where));
+    }
+  }
+
+  /// The [grid] lists (one axis each) and the [[zip]] groups, each path checked against the
+  /// scene and varied once.
+  std::vector<Axis> read_axes(const Scene& base) const {
+    std::vector<Axis> axes;
+    std::set<std::string> varied;
+    auto add_path = [&](Axis& axis, std::string path, std::vector<Value> values) {
+      const long line = values.front().line;
+      if (!varied.insert(path).second)
+        fail(line, fmt::format("parameter '{}' is varied twice; list it once", path));
+      if (path != kDepth) {
+        try {
+          check_parameter_path(base, path);
+        } catch (const OverrideError& error) {
+          fail(line, error.what());
+        }
+      }
+      axis.paths.push_back(std::move(path));
+      axis.columns.push_back(std::move(values));
+    };
+    if (const toml::node* grid = document_.get("grid")) {
+      if (!grid->is_table()) fail(line_of(*grid), "'grid' must be a table: [grid]");
+      std::vector<std::pair<std::string, std::vector<Value>>> lists;
+      collect_lists(*grid->as_table(), "", "in [grid]", lists);
+      for (auto& [path, values] : lists) add_path(axes.emplace_back(), path, std::move(values));
+    }
+    if (const toml::node* zips = document_.get("zip")) {
+      const toml::array* groups = zips->as_array();
+      if (!groups || !groups->is_array_of_tables())
+        fail(line_of(*zips), "'zip' must be an array of tables: [[zip]]");
+      for (const toml::node& group : *groups) {
+        std::vector<std::pair<std::string, std::vector<Value>>> lists;
+        collect_lists(*group.as_table(), "", "in [[zip]]", lists);
+        if (lists.empty()) fail(line_of(group), "a [[zip]] group must list at least one parameter");
+        for (const auto& [path, values] : lists)
+          if (values.size() != lists.front().second.size())
+            fail(line_of(group),
+                 fmt::format("the lists of a [[zip]] group must have equal lengths: '{}' has {} "
+                             "values, '{}' has {}",
+                             lists.front().first, lists.front().second.size(), path,
+                             values.size()));
+        Axis& axis = axes.emplace_back();
+        for (auto& [path, values] : lists) add_path(axis, path, std::move(values));
+      }
+    }
+    return axes;
+  }
+
+  /// The depth of jobs whose axes do not vary it: the top-level `depth`, 1 if absent.
+  Value default_depth(const std::vector<Axis>& axes) const {
+    const toml::node* node = document_.get(kDepth);
+    if (!node) return {1, 0};
+    for (const Axis& axis : axes)
+      for (const std::string& path : axis.paths)
+        if (path == kDepth)
+          fail(line_of(*node), "'depth' is given at the top level and varied; give it once");
+    return {scalar_json(*node), line_of(*node)};
+  }
+
+  /// Calls `visit` with every combination of one index per axis, the last axis fastest.
+  static void for_each_combination(const std::vector<Axis>& axes,
+                                   const std::function<void(const std::vector<std::size_t>&)>& visit) {
+    std::vector<std::size_t> pick(axes.size(), 0);
+    while (true) {
+      visit(pick);
+      std::size_t axis = axes.size();
+      while (axis > 0 && ++pick[axis - 1] == axes[axis - 1].size()) pick[--axis] = 0;
+      if (axis == 0) return;
+    }
+  }
+
+  /// The job at `pick`, its values made canonical and applied to the base scene. An impossible
+  /// value is reported at its line with the job's parameters.
+  SweepJob make_job(const Scene& base, const std::string& scene_hash, const std::vector<Axis>& axes,
+                    const std::vector<std::size_t>& pick, const Value& depth_default) const {
+    std::map<std::string, Value> chosen;
+    for (std::size_t a = 0; a < axes.size(); ++a)
+      for (std::size_t p = 0; p < axes[a].paths.size(); ++p)
+        chosen[axes[a].paths[p]] = axes[a].columns[p][pick[a]];
+    if (!chosen.count(kDepth)) chosen[kDepth] = depth_default;
+
+    SweepJob job;
+    auto fail_job = [&](const Value& value, const std::string& message) {
+      std::string parameters;
+      for (const auto& [path, v] : chosen)
+        parameters += fmt::format("{}{}={}", parameters.empty() ? "" : " ", path, v.raw.dump());
+      fail(value.line, fmt::format("job {}: {}", parameters, message));
+    };
+    for (const auto& [path, value] : chosen) {
+      if (path == kDepth) {
+        if (!value.raw.is_number_integer() || value.raw.get<std::int64_t>() < 1 ||
+            value.raw.get<std::int64_t>() > 64)
+          fail_job(value, fmt::format("'depth' must be an integer in [1, 64] (got {})",
+                                      value.raw.dump()));
+        job.depth = value.raw.get<int>();
+        continue;
+      }
+      try {
+        job.overrides[path] = canonical_override(base, path, value.raw);
+      } catch (const OverrideError& error) {
+        fail_job(value, error.what());
+      }
+    }
+    apply_overrides(base, job.overrides);
+    job.parameters = canonical_parameters(scene_hash, job.overrides, job.depth);
+    job.id = job_id(job.parameters);
+    return job;
+  }
+
+  fs::path file_;
+  toml::table document_;
+};
+
+}  // namespace
+
+Sweep read_sweep(const fs::path& file) { return SweepReader(fs::absolute(file)).read(); }
+
+std::string describe_parameters(const SweepJob& job) {
+  std::string text = fmt::format("depth={}", job.depth);
+  for (const auto& [path, value] : job.overrides) text += fmt::format(" {}={}", path, value.dump());
+  return text;
+}
+
+std::vector<db::NewJob> new_jobs(const Sweep& sweep) {
+  std::vector<db::NewJob> jobs;
+  for (const SweepJob& job : sweep.jobs)
+    jobs.push_back({.id = job.id,
+                    .parameters = job.parameters,
+                    .scene = sweep.scene.string(),
+                    .depth = job.depth});
+  return jobs;
+}
+
+}  // namespace psq::jobs

@@ -1,0 +1,53 @@
+#pragma once
+// Sweep files (TOML, docs/sweep-format.md): a base scene and variations of its parameters,
+// expanded into jobs. Every job is validated by applying its overrides to the parsed scene
+// before anything is stored, so a bad value is reported at its line and no job of the sweep
+// is added.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "db/job_records.hpp"
+#include "jobs/job_identity.hpp"
+
+namespace psq::jobs {
+
+/// One expanded job of a sweep.
+struct SweepJob {
+  Overrides overrides;        ///< canonical values (see canonical_override)
+  int depth = 1;              ///< hierarchy levels
+  nlohmann::json parameters;  ///< canonical_parameters(scene hash, overrides, depth)
+  std::string id;             ///< job_id(parameters)
+};
+
+/// A sweep file, expanded.
+struct Sweep {
+  std::string name;
+  std::filesystem::path file;   ///< the sweep file, absolute
+  std::filesystem::path scene;  ///< the base scene file, absolute and normalized
+  std::string scene_hash;       ///< file_content_hash(scene)
+  /// The jobs in expansion order: the cartesian product of the [grid] lists and the [[zip]]
+  /// groups, in the order the axes are listed below, the last axis varying fastest. Grid
+  /// axes come first (sorted by path, as TOML tables are unordered), then the zip groups in
+  /// file order.
+  std::vector<SweepJob> jobs;
+};
+
+/// Reads and expands a sweep file; reads its scene and applies every job's overrides to it.
+/// Throws InputError "file:line: message" for: TOML syntax errors, unknown keys (with the
+/// nearest valid key), a missing name or scene, a scene file that does not exist or is
+/// invalid (reported in the scene file), unknown parameter paths (with the nearest valid
+/// path), lists that are empty or not lists, zipped lists of different lengths, a path varied
+/// twice, two jobs with the same parameters, and impossible values (reported at the value's
+/// line with the first job that has it, e.g. negative thickness, ν ≥ 0.5, depth 0).
+Sweep read_sweep(const std::filesystem::path& file);
+
+/// "depth=1 shell.cloth.material.thickness=0.0005 ...": a job's parameters on one line, paths
+/// sorted.
+std::string describe_parameters(const SweepJob& job);
+
+/// The jobs of a sweep as the store takes them.
+std::vector<db::NewJob> new_jobs(const Sweep& sweep);
+
+}  // namespace psq::jobs
