@@ -45,13 +45,6 @@ constexpr std::array<PointFeature, 8> kBoundarySubCases{{{0, 1, {2, 0}},
                                                          {3, 2, {0, 1}}}};
 static_assert(static_cast<int>(EdgeEdgeCase::LineLine) == kBoundarySubCases.size());
 
-StencilPositions stencil(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
-                         const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
-  StencilPositions x;
-  x << ea0, ea1, eb0, eb1;
-  return x;
-}
-
 }  // namespace
 
 double line_line_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
@@ -68,7 +61,7 @@ StencilDerivatives<12> line_line_distance_derivatives(const Eigen::Vector3d& ea0
   const Eigen::Vector4d w(1 - pair.s, pair.s, pair.t - 1, -pair.t);
   Eigen::Matrix<double, 4, 2> dw_dst;
   dw_dst << -1, 0, 1, 0, 0, 1, 0, -1;
-  return closest_pair_distance_derivatives<4, 2>(stencil(ea0, ea1, eb0, eb1), w, dw_dst, pair.q);
+  return closest_pair_distance_derivatives<4, 2>(stack_stencil(ea0, ea1, eb0, eb1), w, dw_dst, pair.q);
 }
 
 double edge_edge_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
@@ -76,7 +69,7 @@ double edge_edge_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1
   const EdgeEdgeCase c = edge_edge_case(ea0, ea1, eb0, eb1);
   if (c == EdgeEdgeCase::LineLine) return line_line_distance(ea0, ea1, eb0, eb1);
   return point_feature_distance(kBoundarySubCases[static_cast<int>(c)],
-                                stencil(ea0, ea1, eb0, eb1));
+                                stack_stencil(ea0, ea1, eb0, eb1));
 }
 
 StencilDerivatives<12> edge_edge_distance_derivatives(const Eigen::Vector3d& ea0,
@@ -86,7 +79,7 @@ StencilDerivatives<12> edge_edge_distance_derivatives(const Eigen::Vector3d& ea0
   const EdgeEdgeCase c = edge_edge_case(ea0, ea1, eb0, eb1);
   if (c == EdgeEdgeCase::LineLine) return line_line_distance_derivatives(ea0, ea1, eb0, eb1);
   return point_feature_distance_derivatives(kBoundarySubCases[static_cast<int>(c)],
-                                            stencil(ea0, ea1, eb0, eb1));
+                                            stack_stencil(ea0, ea1, eb0, eb1));
 }
 
 }  // namespace psq

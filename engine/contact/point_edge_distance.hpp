@@ -104,6 +104,14 @@ StencilDerivatives<9> point_edge_distance_derivatives(const Eigen::Vector3d& p,
 /// (ea0, ea1, eb0, eb1) for edge–edge.
 using StencilPositions = Eigen::Matrix<double, 3, 4>;
 
+/// The four vertices of a point–triangle or edge–edge pair as the columns of one matrix.
+inline StencilPositions stack_stencil(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                      const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  StencilPositions x;
+  x << a, b, c, d;
+  return x;
+}
+
 /// A point–point or point–edge sub-case of a 4-vertex stencil: the stencil vertex that is the
 /// point, and the one stencil vertex (feature_size 1) or the two edge endpoints (feature_size
 /// 2, measured to the edge's line) it is measured to.

@@ -35,13 +35,6 @@ constexpr std::array<PointFeature, 6> kBoundarySubCases{{{0, 1, {1, 0}},
                                                          {0, 2, {3, 1}}}};
 static_assert(static_cast<int>(PointTriangleCase::Face) == kBoundarySubCases.size());
 
-StencilPositions stencil(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
-                         const Eigen::Vector3d& t1, const Eigen::Vector3d& t2) {
-  StencilPositions x;
-  x << p, t0, t1, t2;
-  return x;
-}
-
 }  // namespace
 
 double point_plane_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
@@ -58,14 +51,14 @@ StencilDerivatives<12> point_plane_distance_derivatives(const Eigen::Vector3d& p
   const Eigen::Vector4d w(1, foot.beta1 + foot.beta2 - 1, -foot.beta1, -foot.beta2);
   Eigen::Matrix<double, 4, 2> dw_dbeta;
   dw_dbeta << 0, 0, 1, 1, -1, 0, 0, -1;
-  return closest_pair_distance_derivatives<4, 2>(stencil(p, t0, t1, t2), w, dw_dbeta, foot.q);
+  return closest_pair_distance_derivatives<4, 2>(stack_stencil(p, t0, t1, t2), w, dw_dbeta, foot.q);
 }
 
 double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
                                const Eigen::Vector3d& t1, const Eigen::Vector3d& t2) {
   const PointTriangleCase c = point_triangle_case(p, t0, t1, t2);
   if (c == PointTriangleCase::Face) return point_plane_distance(p, t0, t1, t2);
-  return point_feature_distance(kBoundarySubCases[static_cast<int>(c)], stencil(p, t0, t1, t2));
+  return point_feature_distance(kBoundarySubCases[static_cast<int>(c)], stack_stencil(p, t0, t1, t2));
 }
 
 StencilDerivatives<12> point_triangle_distance_derivatives(const Eigen::Vector3d& p,
@@ -75,7 +68,7 @@ StencilDerivatives<12> point_triangle_distance_derivatives(const Eigen::Vector3d
   const PointTriangleCase c = point_triangle_case(p, t0, t1, t2);
   if (c == PointTriangleCase::Face) return point_plane_distance_derivatives(p, t0, t1, t2);
   return point_feature_distance_derivatives(kBoundarySubCases[static_cast<int>(c)],
-                                            stencil(p, t0, t1, t2));
+                                            stack_stencil(p, t0, t1, t2));
 }
 
 }  // namespace psq
