@@ -1,5 +1,7 @@
 #include "engine/io/checkpoint.hpp"
 
+#include "engine/core/atomic_file.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -8,14 +10,12 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fcntl.h>
 #include <fstream>
 #include <iterator>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <stdexcept>
-#include <unistd.h>
 #include <utility>
 
 #include "engine/io/checksum.hpp"
@@ -312,33 +312,16 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   return c;
 }
 
-/// Forces a written file to disk and returns the FNV-1a 64 checksum of its bytes.
-std::uint64_t sync_and_checksum(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot reopen: {}", std::strerror(errno)));
-  const int synced = ::fsync(fd);
-  const int sync_error = errno;
+/// The FNV-1a 64 checksum of a file's bytes.
+std::uint64_t file_checksum(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("cannot reopen: {}", std::strerror(errno)));
   Fnv1a64 hash;
-  std::vector<std::byte> block(std::size_t{1} << 16);
-  ssize_t count = 0;
-  while ((count = ::read(fd, block.data(), block.size())) > 0)
-    hash.update(std::span(block.data(), static_cast<std::size_t>(count)));
-  const int read_error = errno;
-  ::close(fd);
-  if (synced != 0) throw std::runtime_error(fmt::format("fsync: {}", std::strerror(sync_error)));
-  if (count < 0) throw std::runtime_error(fmt::format("read: {}", std::strerror(read_error)));
+  std::vector<char> block(std::size_t{1} << 16);
+  while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0)
+    hash.update(std::as_bytes(std::span(block.data(), static_cast<std::size_t>(in.gcount()))));
+  if (in.bad()) throw std::runtime_error("read error");
   return hash.value();
-}
-
-/// Makes a rename in `dir` durable.
-void sync_directory(const std::filesystem::path& dir) {
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
-  const bool synced = fd >= 0 && ::fsync(fd) == 0;
-  const int error = errno;
-  if (fd >= 0) ::close(fd);
-  if (!synced)
-    throw std::runtime_error(fmt::format("cannot sync directory '{}': {}", dir.string(),
-                                         std::strerror(error)));
 }
 
 std::vector<char> read_bytes(const std::filesystem::path& path) {
@@ -362,20 +345,17 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
   const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
   if (std::error_code error; !std::filesystem::is_directory(directory, error))
     fail(file_name, fmt::format("cannot write checkpoint: no directory '{}'", directory.string()));
-  const std::filesystem::path temporary =
-      path.parent_path() / fmt::format(".{}.tmp{}", path.filename().string(), ::getpid());
   try {
-    {
-      const std::lock_guard lock(hdf5_mutex());
-      encode(checkpoint, temporary);
-    }
-    const std::uint64_t checksum = sync_and_checksum(temporary);
-    std::filesystem::rename(temporary, path);
-    sync_directory(directory);
+    std::uint64_t checksum = 0;
+    replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
+      {
+        const std::lock_guard lock(hdf5_mutex());
+        encode(checkpoint, temporary);
+      }
+      checksum = file_checksum(temporary);
+    });
     return checksum;
   } catch (const std::exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
     // HDF5 errors name the temporary file; the caller knows the checkpoint by its final name.
     fail(file_name, fmt::format("cannot write checkpoint: {}", e.what()));
   }
