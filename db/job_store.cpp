@@ -4,6 +4,8 @@
 #include <fmt/ranges.h>
 
 #include <chrono>
+#include <sqlite3.h>
+#include <thread>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -28,9 +30,27 @@ const std::filesystem::path& with_parent_directories(const std::filesystem::path
 /// at checkpoints, not at every commit: a killed process loses nothing, and a power loss can
 /// only roll back the last commits, which the lease protocol absorbs (a job reverts to running
 /// and is rerun once its lease expires).
-void configure(SqliteConnection& connection) {
-  auto journal = connection.prepare("PRAGMA journal_mode = WAL");
-  if (!journal.step() || journal.text(0) != "wal")
+///
+/// Switching a new database to WAL needs an exclusive lock, and SQLite answers SQLITE_BUSY at
+/// once (without the busy handler) while another process is creating the same file, so the
+/// switch is retried for up to the busy timeout.
+std::string enable_wal(SqliteConnection& connection, int busy_timeout_ms) {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(busy_timeout_ms);
+  for (;;) {
+    try {
+      auto journal = connection.prepare("PRAGMA journal_mode = WAL");
+      return journal.step() ? journal.text(0) : std::string();
+    } catch (const DatabaseError& e) {
+      if ((e.sqlite_code() & 0xff) != SQLITE_BUSY || std::chrono::steady_clock::now() > deadline)
+        throw;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+}
+
+void configure(SqliteConnection& connection, int busy_timeout_ms) {
+  if (enable_wal(connection, busy_timeout_ms) != "wal")
     throw InputError(fmt::format(
         "{}: the job store needs SQLite's WAL mode, which this file system refused; keep the "
         "database on a local disk",
@@ -129,7 +149,7 @@ void validate_new_job(const std::string& sweep, const NewJob& job) {
 JobStore::JobStore(const std::filesystem::path& path, JobStoreOptions options)
     : options_(std::move(options)),
       connection_(with_parent_directories(path), options_.busy_timeout_ms) {
-  configure(connection_);
+  configure(connection_, options_.busy_timeout_ms);
   migrate(connection_);
 }
 
