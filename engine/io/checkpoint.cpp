@@ -111,6 +111,7 @@ std::uint64_t content_checksum(const Checkpoint& c, int schema_version) {
   hash_matrix(hash, c.positions);
   hash_matrix(hash, c.rest_positions);
   hash_matrix(hash, c.triangles);
+  hash_matrix(hash, c.finest_positions);
   hash_text(hash, progress_name(c.solver.progress));
   hash_matrix(hash, c.solver.previous_positions);
   hash_value(hash, c.solver.iterations_in_frame);
@@ -144,7 +145,7 @@ std::optional<std::string> inconsistency(const Checkpoint& c) {
   if (c.triangles.size() > 0 && (c.triangles.minCoeff() < 0 || c.triangles.maxCoeff() >= n))
     return fmt::format("triangle vertex indices outside [0, {})", n);
   if (!c.positions.allFinite() || !c.rest_positions.allFinite() ||
-      !c.solver.previous_positions.allFinite())
+      !c.finest_positions.allFinite() || !c.solver.previous_positions.allFinite())
     return std::string("positions contain NaN or infinite values");
   if (!std::isfinite(c.time)) return std::string("the time is NaN or infinite");
   if (!all_named_and_finite(c.solver.scalars) || !all_named_and_finite(c.statistics.timings))
@@ -212,6 +213,7 @@ void encode(const Checkpoint& c, const std::filesystem::path& path) {
   write_rows(root, checkpoint_layout::positions, c.positions);
   write_rows(root, checkpoint_layout::rest_positions, c.rest_positions);
   write_rows(root, checkpoint_layout::triangles, c.triangles);
+  write_rows(root, checkpoint_layout::finest_positions, c.finest_positions);
   write_solver_state(root.create_group("solver"), c.solver);
   write_statistics(root.create_group("statistics"), c.statistics);
   file.close();
@@ -290,6 +292,7 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   c.positions = read_rows<Positions>(root, checkpoint_layout::positions);
   c.rest_positions = read_rows<Positions>(root, checkpoint_layout::rest_positions);
   c.triangles = read_rows<Triangles>(root, checkpoint_layout::triangles);
+  c.finest_positions = read_rows<Positions>(root, checkpoint_layout::finest_positions);
 
   const hdf5::Group solver = root.open_group("solver");
   const std::string progress = solver.read_string_attribute("progress");

@@ -18,7 +18,7 @@ namespace psq {
 
 /// Version of the checkpoint layout written by this program. Raise it whenever the layout or the
 /// content checksum changes; files of a newer version are refused.
-inline constexpr int checkpoint_schema_version = 1;
+inline constexpr int checkpoint_schema_version = 2;
 
 /// A checkpoint that cannot be written, or read back and trusted: missing, truncated, damaged,
 /// foreign or newer. The message names the file and what is wrong.
@@ -78,6 +78,9 @@ struct Checkpoint {
   Positions positions;       ///< n×3, current vertex positions (metres)
   Positions rest_positions;  ///< n×3, rest shape of this level
   Triangles triangles;       ///< m×3, vertex indices of each triangle, 0-based
+  /// The state prolonged to the finest mesh of the hierarchy (equal to `positions` at the
+  /// finest level): what reports compare between levels.
+  Positions finest_positions;
   SolverState solver;
   LevelStatistics statistics;
 };
@@ -87,6 +90,7 @@ namespace checkpoint_layout {
 inline constexpr std::string_view positions = "/mesh/positions";
 inline constexpr std::string_view rest_positions = "/mesh/rest_positions";
 inline constexpr std::string_view triangles = "/mesh/triangles";
+inline constexpr std::string_view finest_positions = "/mesh/finest_positions";
 }  // namespace checkpoint_layout
 
 /// Writes `checkpoint` to `path` atomically: the file is built in memory, written to a temporary

@@ -21,6 +21,7 @@ inline Checkpoint sample_checkpoint(int k, int level, int frame) {
   const int n = k * k;
   c.rest_positions.resize(n, 3);
   c.positions.resize(n, 3);
+  c.finest_positions.resize(2 * n, 3);
   c.solver.previous_positions.resize(n, 3);
   for (int i = 0; i < k; ++i) {
     for (int j = 0; j < k; ++j) {
@@ -29,6 +30,8 @@ inline Checkpoint sample_checkpoint(int k, int level, int frame) {
       c.rest_positions.row(v) << x, y, 0.0;
       c.positions.row(v) << x + 1e-3 * std::sin(3 * x), y, -0.05 * std::sin(M_PI * x) * y;
       c.solver.previous_positions.row(v) << x, y, -0.04 * std::sin(M_PI * x) * y;
+      c.finest_positions.row(2 * v) = c.positions.row(v);
+      c.finest_positions.row(2 * v + 1) << x, y, 0.5;
     }
   }
   c.triangles.resize(2 * (k - 1) * (k - 1), 3);
@@ -64,6 +67,7 @@ inline void expect_same_checkpoint(const Checkpoint& actual, const Checkpoint& e
   EXPECT_TRUE(same(actual.positions, expected.positions));
   EXPECT_TRUE(same(actual.rest_positions, expected.rest_positions));
   EXPECT_TRUE(same(actual.triangles, expected.triangles));
+  EXPECT_TRUE(same(actual.finest_positions, expected.finest_positions));
   EXPECT_TRUE(same(actual.solver.previous_positions, expected.solver.previous_positions));
   EXPECT_EQ(actual.solver.progress, expected.solver.progress);
   EXPECT_EQ(actual.solver.iterations_in_frame, expected.solver.iterations_in_frame);
