@@ -229,17 +229,24 @@ void JobStore::expire_leases(double time) {
 }
 
 std::optional<Claim> JobStore::claim_next(const WorkerInfo& worker, double lease_seconds) {
+  return claim_next(worker, lease_seconds, JobSelection::all());
+}
+
+std::optional<Claim> JobStore::claim_next(const WorkerInfo& worker, double lease_seconds,
+                                          const JobSelection& which) {
   if (worker.id.empty()) throw std::invalid_argument("claim_next: empty worker id");
   if (!(lease_seconds > 0))
     throw std::invalid_argument(fmt::format("claim_next: lease of {} s", lease_seconds));
   Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_selection_exists(which);
   const double time = now();
   expire_leases(time);
   std::string id;
   {
     auto next = connection_.prepare(
-        "SELECT id FROM jobs WHERE state = 'queued' ORDER BY number LIMIT 1");
-    if (!next.step()) {
+        "SELECT id FROM jobs WHERE state = 'queued' AND " + selection_condition(which) +
+        " ORDER BY number LIMIT 1");
+    if (!next.bind_all(selection_value(which)).step()) {
       next.reset();
       transaction.commit();
       return std::nullopt;
@@ -302,6 +309,7 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
                 unless_empty(level.checkpoint_path), unless_empty(level.checkpoint_checksum),
                 unless_empty(level.error), lease.attempt, now())
       .run();
+  if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();
 }
 
@@ -365,6 +373,20 @@ std::int64_t JobStore::cancel(const JobSelection& which) {
           .run();
   transaction.commit();
   return cancelled;
+}
+
+std::int64_t JobStore::requeue_interrupted(const JobSelection& which) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_selection_exists(which);
+  const auto requeued =
+      connection_
+          .prepare("UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
+                   "WHERE state = 'running' AND lease_expiry <= ?2 AND " +
+                   selection_condition(which))
+          .bind_all(selection_value(which), now())
+          .run();
+  transaction.commit();
+  return requeued;
 }
 
 std::int64_t JobStore::retry(const JobSelection& which, bool include_cancelled) {

@@ -32,6 +32,9 @@ struct JobStoreOptions {
   /// Test seam: called inside claim_next's transaction, after the job is chosen and before the
   /// claim is committed (to kill a process while it holds the write lock).
   std::function<void()> inside_claim_transaction;
+  /// Test seam: called inside record_level's transaction, after the row is written and before
+  /// the commit (to kill a process in the middle of a database write).
+  std::function<void()> inside_record_transaction;
 };
 
 /// One connection to a job store. Not thread-safe: use one JobStore per thread (e.g. a second
@@ -59,6 +62,10 @@ class JobStore {
   /// one more failure (or failed, if that was their last attempt). Returns nothing when no
   /// job is queued.
   std::optional<Claim> claim_next(const WorkerInfo& worker, double lease_seconds);
+  /// claim_next among the selected jobs only (e.g. one sweep's). Throws InputError for an
+  /// unknown sweep or job.
+  std::optional<Claim> claim_next(const WorkerInfo& worker, double lease_seconds,
+                                  const JobSelection& which);
   /// Pushes the lease expiry to now + lease.seconds. False if the lease is lost (the worker
   /// must stop the job; its writes would be refused).
   [[nodiscard]] bool heartbeat(const Lease& lease);
@@ -75,6 +82,10 @@ class JobStore {
   /// Cancels the selected queued or running jobs; returns how many. A running job's worker
   /// learns it from its next heartbeat.
   std::int64_t cancel(const JobSelection& which);
+  /// Puts the selected running jobs whose lease has expired back in the queue without counting
+  /// a failure (a user resuming interrupted work: the worker was stopped, the job did not
+  /// fail); returns how many. Throws InputError for an unknown sweep or job.
+  std::int64_t requeue_interrupted(const JobSelection& which);
   /// Puts the selected failed jobs (and cancelled ones, if `include_cancelled`) back in the
   /// queue with their failure count reset; returns how many.
   std::int64_t retry(const JobSelection& which, bool include_cancelled = false);

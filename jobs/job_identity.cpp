@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "engine/core/error.hpp"
-#include "engine/io/checksum.hpp"
+#include "engine/core/checksum.hpp"
 
 namespace psq::jobs {
 

@@ -22,5 +22,12 @@ void register_check_command(CLI::App& app, std::vector<Command>& commands);
 void register_ccd_bench_command(CLI::App& app, std::vector<Command>& commands);
 void register_sweep_command(CLI::App& app, std::vector<Command>& commands);
 void register_status_command(CLI::App& app, std::vector<Command>& commands);
+void register_work_command(CLI::App& app, std::vector<Command>& commands);
+void register_resume_command(CLI::App& app, std::vector<Command>& commands);
+void register_results_command(CLI::App& app, std::vector<Command>& commands);
+void register_cancel_command(CLI::App& app, std::vector<Command>& commands);
+void register_retry_command(CLI::App& app, std::vector<Command>& commands);
+void register_report_command(CLI::App& app, std::vector<Command>& commands);
+void register_hierarchy_command(CLI::App& app, std::vector<Command>& commands);
 
 }  // namespace psq::runner

@@ -19,6 +19,13 @@ int main(int argc, char** argv) {
   psq::runner::register_ccd_bench_command(app, commands);
   psq::runner::register_sweep_command(app, commands);
   psq::runner::register_status_command(app, commands);
+  psq::runner::register_work_command(app, commands);
+  psq::runner::register_resume_command(app, commands);
+  psq::runner::register_results_command(app, commands);
+  psq::runner::register_cancel_command(app, commands);
+  psq::runner::register_retry_command(app, commands);
+  psq::runner::register_report_command(app, commands);
+  psq::runner::register_hierarchy_command(app, commands);
   try {
     app.parse(argc, argv);
     for (const auto& command : commands)

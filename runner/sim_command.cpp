@@ -1,14 +1,17 @@
-// `psq sim SCENE --out DIR`: a direct simulation at the scene's full resolution.
+// `psq sim SCENE --out DIR [--levels L]`: a simulation of a scene, direct at its full
+// resolution (levels = 1) or progressive over a hierarchy of L levels (docs/progressive.md).
 
 #include <fmt/format.h>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <unistd.h>
 
 #include "engine/core/atomic_file.hpp"
 #include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
+#include "engine/progressive/progressive_simulation.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "runner/commands.hpp"
@@ -22,15 +25,65 @@ namespace {
 struct SimOptions {
   std::string scene;
   std::string out;
+  std::optional<int> levels;
 };
 
-void write_frame(const std::filesystem::path& dir, int frame, const TriMesh& rest, const Eigen::VectorXd& x) {
-  TriMesh mesh{as_positions(x), rest.triangles};
-  write_mesh(dir / fmt::format("frame_{:04d}.obj", frame), mesh);
+void write_positions(const std::filesystem::path& path, const TriMesh& rest,
+                     const Eigen::VectorXd& x) {
+  write_mesh(path, TriMesh{as_positions(x), rest.triangles});
 }
 
-int run_sim(const SimOptions& sim_options) {
-  const Scene scene = read_scene(sim_options.scene);
+std::filesystem::path frame_path(const std::filesystem::path& dir, int frame) {
+  return dir / fmt::format("frame_{:04d}.obj", frame);
+}
+
+nlohmann::json step_json(const ProgressiveStep& step) {
+  nlohmann::json out = frame_json(step.frame);
+  out["level"] = step.level;
+  out["settling"] = step.settling;
+  out["change"] = step.change;
+  return out;
+}
+
+/// Totals of one level's steps, with the steps themselves.
+struct LevelRecord {
+  int level = 0;
+  int vertices = 0, triangles = 0;
+  int iterations = 0;
+  double seconds = 0.0;
+  bool converged = true;
+  nlohmann::json steps = nlohmann::json::array();
+
+  [[nodiscard]] nlohmann::json json() const {
+    return {{"level", level},         {"vertices", vertices}, {"triangles", triangles},
+            {"iterations", iterations}, {"seconds", seconds}, {"converged", converged},
+            {"steps", steps}};
+  }
+};
+
+/// Writes summary.json, prints its path, and returns the exit code.
+int finish(const std::filesystem::path& out, const nlohmann::json& summary, bool all_converged) {
+  write_file_atomically(out / "summary.json", [&](std::ostream& o) { o << summary.dump(2) << '\n'; });
+  std::cout << (out / "summary.json").string() << '\n';
+  if (!all_converged) {
+    std::cerr << "psq sim: some frames or levels did not converge (see summary.json)\n";
+    return kExitNotConverged;
+  }
+  return 0;
+}
+
+ProgressiveSettings settings_for(const Scene& scene, const SimOptions& options) {
+  ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
+  if (options.levels) {
+    if (*options.levels < 1)
+      throw InputError(fmt::format("--levels must be at least 1 (got {})", *options.levels));
+    settings.schedule.levels = *options.levels;
+  }
+  return settings;
+}
+
+/// levels = 1: the direct simulation, with contact when the scene has it.
+int run_direct(const Scene& scene, const SimOptions& sim_options) {
   QuasistaticSimulation sim(scene);
   const TriMesh& rest = sim.system().rest_mesh();
   require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
@@ -40,7 +93,7 @@ int run_sim(const SimOptions& sim_options) {
   std::cerr << fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, tolerance {:.3g} m/s\n",
                            scene.name, rest.vertex_count(), rest.triangle_count(), sim.frame_count(),
                            sim.newton_settings().tolerance);
-  write_frame(out, 0, rest, sim.positions());
+  write_positions(frame_path(out, 0), rest, sim.positions());
 
   nlohmann::json frames = nlohmann::json::array();
   bool all_converged = true;
@@ -51,7 +104,7 @@ int run_sim(const SimOptions& sim_options) {
                                  sim.frame_count(), it.iteration, it.step_norm, it.gradient_norm)
                   << std::flush;
     });
-    write_frame(out, record.frame, rest, sim.positions());
+    write_positions(frame_path(out, record.frame), rest, sim.positions());
     all_converged = all_converged && record.newton.converged;
     frames.push_back(frame_json(record));
     std::cerr << fmt::format("{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}, {:.3f} s\n",
@@ -66,27 +119,104 @@ int run_sim(const SimOptions& sim_options) {
       {"triangles", rest.triangle_count()},
       {"time_step", scene.time.step},
       {"tolerance", sim.newton_settings().tolerance},
+      {"level_count", 1},
       {"all_converged", all_converged},
       {"frames", frames},
   };
-  write_file_atomically(out / "summary.json", [&](std::ostream& o) { o << summary.dump(2) << '\n'; });
-  std::cout << (out / "summary.json").string() << '\n';
-  if (!all_converged) {
-    std::cerr << "psq sim: some frames did not converge within solver.max_iterations (see summary.json)\n";
-    return kExitNotConverged;
+  return finish(out, summary, all_converged);
+}
+
+/// levels > 1: the progressive simulation (docs/progressive.md).
+int run_progressive(const Scene& scene, const SimOptions& sim_options,
+                    const ProgressiveSettings& settings) {
+  ProgressiveSimulation sim(scene, settings);
+  const TriMesh& rest = sim.finest_system().rest_mesh();
+  require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
+                            shell_parts(sim.finest_system()));
+  const std::filesystem::path out = prepare_output_dir(sim_options.out);
+  const bool terminal = ::isatty(STDERR_FILENO);
+  std::cerr << fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, {} level(s), "
+                           "tolerance {:.3g} m/s\n",
+                           scene.name, rest.vertex_count(), rest.triangle_count(),
+                           sim.frame_count(), sim.level_count(), sim.finest_tolerance());
+  write_positions(frame_path(out, 0), rest, flat(rest.vertices));
+
+  nlohmann::json frames = nlohmann::json::array();
+  nlohmann::json levels = nlohmann::json::array();
+  bool all_converged = true;
+  for (;;) {
+    const bool finest = sim.level() + 1 == sim.level_count();
+    LevelRecord level{sim.level(), sim.level_rest_mesh().vertex_count(),
+                      sim.level_rest_mesh().triangle_count()};
+    while (!sim.level_done()) {
+      const ProgressiveStep step = sim.step([&](int l, int frame, const NewtonIteration& it) {
+        if (terminal)
+          std::cerr << fmt::format("\r  level {}/{}  frame {}/{}  iteration {}  ‖Δx‖∞/Δt {:.3e}"
+                                   "  ‖g‖ {:.3e}   ",
+                                   l, sim.level_count() - 1, frame, sim.frame_count(),
+                                   it.iteration, it.step_norm, it.gradient_norm)
+                    << std::flush;
+      });
+      // Every frame file holds the finest mesh: previews are prolonged to it.
+      write_positions(frame_path(out, step.frame.frame), rest, sim.finest_positions());
+      level.iterations += step.frame.newton.iterations;
+      level.seconds += step.frame.newton.wall_seconds;
+      level.steps.push_back(step_json(step));
+      if (finest) {
+        frames.push_back(step_json(step));
+        level.converged = level.converged && step.frame.newton.converged;
+      }
+      std::cerr << fmt::format(
+          "{}  level {}/{} frame {}/{}{}: {} iterations, {}, change {:.3e} m/s, {:.3f} s\n",
+          terminal ? "\r" : "", step.level, sim.level_count() - 1, step.frame.frame,
+          sim.frame_count(), step.settling ? " (settling)" : "", step.frame.newton.iterations,
+          step.frame.newton.converged ? "converged" : "NOT converged", step.change,
+          step.frame.newton.wall_seconds);
+    }
+    if (sim.level_count() > 1) level.converged = level.converged && sim.level_converged();
+    all_converged = all_converged && level.converged;
+    write_positions(out / fmt::format("level_{}.obj", sim.level()), sim.level_rest_mesh(),
+                    sim.positions());
+    levels.push_back(level.json());
+    if (sim.finished()) break;
+    sim.refine();
   }
-  return 0;
+  const nlohmann::json summary = {
+      {"scene", scene.name},
+      {"scene_file", scene.source.string()},
+      {"vertices", rest.vertex_count()},
+      {"triangles", rest.triangle_count()},
+      {"time_step", scene.time.step},
+      {"tolerance", sim.finest_tolerance()},
+      {"level_count", sim.level_count()},
+      {"refine_frame", sim.refine_frame()},
+      {"all_converged", all_converged},
+      {"frames", frames},
+      {"levels", levels},
+  };
+  return finish(out, summary, all_converged);
+}
+
+int run_sim(const SimOptions& sim_options) {
+  const Scene scene = read_scene(sim_options.scene);
+  const ProgressiveSettings settings = settings_for(scene, sim_options);
+  return settings.schedule.levels == 1 ? run_direct(scene, sim_options)
+                                       : run_progressive(scene, sim_options, settings);
 }
 
 }  // namespace
 
 void register_sim_command(CLI::App& app, std::vector<Command>& commands) {
   auto options = std::make_shared<SimOptions>();
-  CLI::App* command = app.add_subcommand("sim", "Simulate a scene at its full resolution");
+  CLI::App* command = app.add_subcommand(
+      "sim", "Simulate a scene, directly at its full resolution or progressively over levels");
   command->add_option("scene", options->scene, "Scene file (TOML, see docs/scene-format.md)")
       ->required();
-  command->add_option("--out", options->out, "Output directory for frame meshes and summary.json")
+  command->add_option("--out", options->out,
+                      "Output directory for frame meshes, level meshes and summary.json")
       ->required();
+  command->add_option("--levels", options->levels,
+                      "Hierarchy levels (overrides [hierarchy] levels; 1 = direct)");
   commands.push_back({command, [options] { return run_sim(*options); }});
 }
 

@@ -1,6 +1,10 @@
 #include "runner/workspace.hpp"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
+
+#include "engine/core/error.hpp"
 
 namespace psq::runner {
 
@@ -15,6 +19,49 @@ void add_database_option(CLI::App& command, std::string& path) {
   command.add_option("--db", path,
                      "Job store (SQLite); default $PSQ_DB, else .psq/psq.db in the current "
                      "directory");
+}
+
+std::filesystem::path runs_directory(const std::filesystem::path& database) {
+  return std::filesystem::absolute(database).parent_path() / "runs";
+}
+
+void require_database(const std::filesystem::path& database) {
+  if (!std::filesystem::exists(database))
+    throw InputError(
+        fmt::format("{}: no job store here; add a sweep first (psq sweep add FILE) "
+                    "or choose the store with --db or PSQ_DB",
+                    database.string()));
+}
+
+db::JobSelection sweep_or_job(db::JobStore& store, const std::string& target) {
+  for (const db::SweepStatus& sweep : store.status())
+    if (sweep.name == target) return db::JobSelection::sweep(target);
+  if (store.find_job(target)) return db::JobSelection::job(target);
+  throw InputError(
+      fmt::format("{}: '{}' is neither a sweep nor a job id (psq status lists the "
+                  "sweeps, psq results SWEEP their jobs)",
+                  store.path().string(), target));
+}
+
+void add_work_options(CLI::App& command, WorkSettings& settings) {
+  add_database_option(command, settings.database);
+  command.add_option("--workers", settings.workers, "Worker processes (default: one per core)")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--lease", settings.lease_seconds,
+                  "Seconds a job stays claimed without a heartbeat (heartbeats every third)")
+      ->check(CLI::PositiveNumber);
+  command
+      .add_option("--snapshot-iterations", settings.snapshot_iterations,
+                  "Write an in-level snapshot after this many Newton iterations")
+      ->check(CLI::PositiveNumber);
+  command
+      .add_option("--snapshot-seconds", settings.snapshot_seconds,
+                  "...or after this many seconds since the last checkpoint")
+      ->check(CLI::PositiveNumber);
+  command.add_option("--worker-number", settings.worker_number)
+      ->group("")  // internal: set by the supervisor for its worker processes
+      ->check(CLI::NonNegativeNumber);
 }
 
 }  // namespace psq::runner

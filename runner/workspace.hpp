@@ -1,11 +1,14 @@
 #pragma once
 // Where psq keeps its state: the workspace directory `.psq/` in the current directory, with
-// the job store `.psq/psq.db`. `--db PATH` or the PSQ_DB environment variable choose another
-// store.
+// the job store `.psq/psq.db` and the job outputs `.psq/runs/<job id>/`. `--db PATH` or the
+// PSQ_DB environment variable choose another store; the outputs are always in `runs/` beside
+// it. Also the settings of the commands that run jobs (`psq work`, `psq resume`).
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <string>
+
+#include "db/job_store.hpp"
 
 namespace psq::runner {
 
@@ -15,5 +18,33 @@ std::filesystem::path database_path(const std::string& option);
 
 /// Adds `--db PATH` to a subcommand, filling `path`.
 void add_database_option(CLI::App& command, std::string& path);
+
+/// The directory of the job outputs that belong to the store at `database`: `runs/` beside it.
+std::filesystem::path runs_directory(const std::filesystem::path& database);
+
+/// Throws InputError naming `database` and how to create it when no store is there.
+void require_database(const std::filesystem::path& database);
+
+/// The sweep named `target`, else the job with that id. Throws InputError naming the store when
+/// neither exists.
+db::JobSelection sweep_or_job(db::JobStore& store, const std::string& target);
+
+/// How `psq work` and `psq resume` run jobs.
+struct WorkSettings {
+  std::string database;
+  int workers = 0;  ///< worker processes; 0 = one per core
+  double lease_seconds = 30.0;
+  int snapshot_iterations = 50;
+  double snapshot_seconds = 60.0;
+  std::string sweep;      ///< claim only this sweep's jobs (empty: every sweep)
+  int worker_number = 0;  ///< > 0 in a worker process started by a supervisor
+};
+
+/// Adds the options shared by `psq work` and `psq resume` to `command`.
+void add_work_options(CLI::App& command, WorkSettings& settings);
+
+/// Runs queued jobs until none is left (see docs/runner.md); returns the exit code: 0 when
+/// every job run finished, 5 when one failed, 128 + signal when stopped by a signal.
+int run_work(const WorkSettings& settings);
 
 }  // namespace psq::runner

@@ -8,7 +8,8 @@ packages=(
   libhdf5-dev libsqlite3-dev sqlite3 libfmt-dev libtbb-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox
+  gnuplot-nox  # plots in sweep reports (psq report)
+  chromium     # headless browser: the test that opens the HTML report
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -6,10 +6,12 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <span>
 #include <sstream>
 #include <system_error>
 
 #include "engine/core/atomic_file.hpp"
+#include "engine/core/checksum.hpp"
 #include "engine/core/error.hpp"
 
 namespace psq {
@@ -19,23 +21,21 @@ namespace {
 constexpr char kMagic[8] = {'P', 'S', 'Q', 'H', 'I', 'E', 'R', '\0'};
 constexpr double kBarycentricTolerance = 1e-9;
 
-/// 64-bit FNV-1a. engine/io/checksum.hpp has the same function, but psq_hierarchy does not
-/// link psq_io; see docs/hierarchy.md.
+/// FNV-1a over the raw bytes of values and arrays, for the cache key.
 class Hash {
  public:
   Hash& bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) state_ = (state_ ^ p[i]) * 1099511628211ull;
+    fnv_.update(std::span(static_cast<const std::byte*>(data), size));
     return *this;
   }
   template <typename T>
   Hash& value(const T& v) {
     return bytes(&v, sizeof v);
   }
-  [[nodiscard]] std::uint64_t result() const { return state_; }
+  [[nodiscard]] std::uint64_t result() const { return fnv_.value(); }
 
  private:
-  std::uint64_t state_ = 14695981039346656037ull;
+  Fnv1a64 fnv_;
 };
 
 class Writer {
@@ -194,9 +194,7 @@ bool valid_hierarchy(const MeshHierarchy& h, const TriMesh& finest) {
   return true;
 }
 
-std::uint64_t checksum(std::string_view bytes) {
-  return Hash().bytes(bytes.data(), bytes.size()).result();
-}
+std::uint64_t checksum(std::string_view bytes) { return Fnv1a64().update(bytes).value(); }
 
 std::string read_whole_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -18,7 +18,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "engine/io/checksum.hpp"
+#include "engine/core/checksum.hpp"
 #include "engine/io/hdf5_handle.hpp"
 
 namespace psq {

@@ -53,10 +53,17 @@ std::string_view kind_name(H5T_class_t kind) {
   }
 }
 
-/// HDF5 prints its error stack to stderr by default; errors here become exceptions instead.
-void silence_error_printing() {
+/// Once per process: HDF5 prints its error stack to stderr by default (errors here become
+/// exceptions instead), and it closes leftover files at exit (see below).
+void initialize_library() {
   static std::once_flag once;
-  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+  std::call_once(once, [] {
+    // A file whose final flush failed (disk full) stays in HDF5's open list; the library's
+    // exit-time cleanup would try to close it again and crash. Its temporary is discarded by
+    // then, so there is nothing left for that cleanup to save.
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  });
 }
 
 herr_t keep_first_description(unsigned, const H5E_error2_t* entry, void* sink) {
@@ -290,7 +297,7 @@ File::File(std::string name, Id id)
 }
 
 File File::create(const std::filesystem::path& path) {
-  silence_error_printing();
+  initialize_library();
   std::string name = path.string();
   Id access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   // H5F_CLOSE_SEMI: closing the file while one of its objects is open is an error, rather
@@ -305,7 +312,7 @@ File File::create(const std::filesystem::path& path) {
 }
 
 File File::open_image(std::string name, std::span<const char> bytes) {
-  silence_error_printing();
+  initialize_library();
   // Without an image the core driver would read the named file from disk instead.
   if (bytes.empty()) fail(name, "/", "the file is empty");
   Id access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);

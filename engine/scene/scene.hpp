@@ -84,6 +84,44 @@ struct SolverSettings {
   int max_iterations = 200;  ///< Newton iterations per frame before reporting non-convergence
 };
 
+/// The [hierarchy] table: progressive simulation over a coarse-to-fine hierarchy (paper §3,
+/// §4.5). levels = 1 is a direct simulation of the scene's own meshes.
+struct HierarchyOptions {
+  int levels = 1;              ///< levels including the finest
+  double vertex_ratio = 0.25;  ///< each coarser level keeps about this fraction of the vertices
+  /// Preview levels stop when a step changes the solution by less than this (‖Δx‖∞/Δt)
+  /// [m/s]. Unset: 10 × the solver tolerance.
+  std::optional<double> preview_tolerance;
+  int preview_iterations = 8;  ///< Newton-type iterations per preview step at most
+  std::optional<int> refine_frame;  ///< the frame where levels are refined; unset: the last
+};
+
+/// The [contact] table: IPC contact between shells, shell self-contact and colliders.
+struct ContactSettings {
+  /// Unset: on when the scene has more than one body (shells and colliders) or self_contact.
+  std::optional<bool> enabled;
+  bool self_contact = false;  ///< whether each shell may touch itself
+  /// d̂ [m], the gap below which the barrier acts. Unset: 1e-3 × the bounding-box diagonal.
+  std::optional<double> activation_distance;
+  double thickness = 0.0;           ///< ξ [m], the offset of the contact surface (≥ 0)
+  std::optional<double> stiffness;  ///< κ; unset: IPC's automatic choice and updates
+  double friction = 0.0;            ///< μ, the friction coefficient between any two bodies
+  double ccd_rescaling = 0.9;       ///< s of the additive CCD (fraction of the safe advance)
+  double ccd_ratio_bound = 0.1;     ///< r: a CCD step keeps at least r × the initial gap
+  int ccd_max_iterations = 10'000;  ///< CCD advances per pair before stopping conservatively
+  /// Skip the barrier and the CCD when no pair is within reach (a speed-up only; off to measure
+  /// it).
+  bool skip_when_apart = true;
+};
+
+/// A rigid triangle mesh taking part in contact: fixed, or moved by keyframed rigid motions
+/// (each vertex follows the motions from its placed rest position, like a pinned set).
+struct Collider {
+  std::string name;
+  MeshSource mesh;
+  std::vector<RigidMotion> motions;  ///< empty: fixed in place
+};
+
 struct Scene {
   std::filesystem::path source;  ///< the scene file, for messages and relative paths
   std::string name;
@@ -91,6 +129,9 @@ struct Scene {
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< [m/s²]
   TimeStepping time;
   SolverSettings solver;
+  HierarchyOptions hierarchy;
+  ContactSettings contact;
+  std::vector<Collider> colliders;
 };
 
 }  // namespace psq

@@ -543,6 +543,89 @@ SolverSettings read_solver(const Section& root) {
   return solver;
 }
 
+/// The [hierarchy] table; refine_frame must name one of the scene's frames.
+HierarchyOptions read_hierarchy(const Section& root, const TimeStepping& time) {
+  HierarchyOptions hierarchy;
+  const auto section = root.optional_table("hierarchy");
+  if (!section) return hierarchy;
+  section->allow_only(
+      {"levels", "vertex_ratio", "preview_tolerance", "preview_iterations", "refine_frame"});
+  hierarchy.levels = section->get<int>("levels", hierarchy.levels);
+  section->check(hierarchy.levels >= 1, "levels",
+                 fmt::format("at least 1 (got {})", hierarchy.levels));
+  hierarchy.vertex_ratio = section->get<double>("vertex_ratio", hierarchy.vertex_ratio);
+  section->check(hierarchy.vertex_ratio > 0 && hierarchy.vertex_ratio < 1, "vertex_ratio",
+                 fmt::format("in (0, 1) (got {:g})", hierarchy.vertex_ratio));
+  hierarchy.preview_tolerance = section->get_optional<double>("preview_tolerance");
+  if (hierarchy.preview_tolerance)
+    section->check(*hierarchy.preview_tolerance > 0, "preview_tolerance",
+                   fmt::format("positive (got {:g})", *hierarchy.preview_tolerance));
+  hierarchy.preview_iterations =
+      section->get<int>("preview_iterations", hierarchy.preview_iterations);
+  section->check(hierarchy.preview_iterations >= 1, "preview_iterations",
+                 fmt::format("at least 1 (got {})", hierarchy.preview_iterations));
+  hierarchy.refine_frame = section->get_optional<int>("refine_frame");
+  if (hierarchy.refine_frame)
+    section->check(*hierarchy.refine_frame >= 1 && *hierarchy.refine_frame <= time.frames,
+                   "refine_frame",
+                   fmt::format("a frame in 1..{} ([time] frames; got {})", time.frames,
+                               *hierarchy.refine_frame));
+  return hierarchy;
+}
+
+/// A number of `section` that must lie in the open interval (0, 1).
+double read_unit_fraction(const Section& section, std::string_view key, double fallback) {
+  const double value = section.get<double>(key, fallback);
+  section.check(value > 0 && value < 1, key, fmt::format("in (0, 1) (got {:g})", value));
+  return value;
+}
+
+/// The [contact] table with its optional [contact.ccd] sub-table.
+ContactSettings read_contact(const Section& root) {
+  ContactSettings contact;
+  const auto section = root.optional_table("contact");
+  if (!section) return contact;
+  section->allow_only({"enabled", "self_contact", "activation_distance", "thickness", "stiffness",
+                       "friction", "skip_when_apart", "ccd"});
+  contact.enabled = section->get_optional<bool>("enabled");
+  contact.self_contact = section->get<bool>("self_contact", contact.self_contact);
+  contact.activation_distance = section->get_optional<double>("activation_distance");
+  if (contact.activation_distance)
+    section->check(*contact.activation_distance > 0, "activation_distance",
+                   fmt::format("positive (got {:g})", *contact.activation_distance));
+  contact.thickness = section->get<double>("thickness", contact.thickness);
+  section->check(contact.thickness >= 0, "thickness",
+                 fmt::format("at least 0 (got {:g})", contact.thickness));
+  contact.stiffness = section->get_optional<double>("stiffness");
+  if (contact.stiffness)
+    section->check(*contact.stiffness > 0, "stiffness",
+                   fmt::format("positive (got {:g})", *contact.stiffness));
+  contact.friction = section->get<double>("friction", contact.friction);
+  section->check(contact.friction >= 0, "friction",
+                 fmt::format("at least 0 (got {:g})", contact.friction));
+  contact.skip_when_apart = section->get<bool>("skip_when_apart", contact.skip_when_apart);
+  if (const auto ccd = section->optional_table("ccd")) {
+    ccd->allow_only({"rescaling", "ratio_bound", "max_iterations"});
+    contact.ccd_rescaling = read_unit_fraction(*ccd, "rescaling", contact.ccd_rescaling);
+    contact.ccd_ratio_bound = read_unit_fraction(*ccd, "ratio_bound", contact.ccd_ratio_bound);
+    contact.ccd_max_iterations = ccd->get<int>("max_iterations", contact.ccd_max_iterations);
+    ccd->check(contact.ccd_max_iterations >= 1, "max_iterations",
+               fmt::format("at least 1 (got {})", contact.ccd_max_iterations));
+  }
+  return contact;
+}
+
+/// A [[collider]]: a name, a mesh with its placement (as for shells) and optional motions.
+Collider read_collider(const Section& section, const fs::path& scene_path) {
+  section.allow_only({"name", "mesh", "placement", "motion"});
+  Collider collider;
+  collider.name = read_name(section);
+  collider.mesh = read_mesh_source(section, scene_path);
+  for (const Section& motion : section.tables("motion"))
+    collider.motions.push_back(read_motion(motion));
+  return collider;
+}
+
 toml::table parse_toml(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(located_message(path.string(), 0, "cannot open the scene file"));
@@ -567,7 +650,8 @@ toml::table parse_toml(const fs::path& path) {
 Scene read_scene(const fs::path& path) {
   const toml::table document = parse_toml(path);
   const Section root(document, "", path.string());
-  root.allow_only({"name", "gravity", "time", "solver", "shell"});
+  root.allow_only(
+      {"name", "gravity", "time", "solver", "hierarchy", "contact", "shell", "collider"});
   Scene scene;
   scene.source = path;
   scene.name = root.get<std::string>("name", path.stem().string());
@@ -575,12 +659,18 @@ Scene read_scene(const fs::path& path) {
   scene.gravity = root.get<Eigen::Vector3d>("gravity", scene.gravity);
   scene.time = read_time(root);
   scene.solver = read_solver(root);
+  scene.hierarchy = read_hierarchy(root, scene.time);
   const std::vector<Section> shells = root.tables("shell");
   if (shells.empty()) root.fail(0, "the scene has no shell; add at least one [[shell]] section");
   std::set<std::string> shell_names;
   for (const Section& shell : shells) {
     scene.shells.push_back(read_shell(shell, path));
     check_unique_name(shell, shell_names, scene.shells.back().name, "shell");
+  }
+  scene.contact = read_contact(root);
+  for (const Section& collider : root.tables("collider")) {
+    scene.colliders.push_back(read_collider(collider, path));
+    check_unique_name(collider, shell_names, scene.colliders.back().name, "shell or collider");
   }
   return scene;
 }

@@ -1,7 +1,12 @@
 #pragma once
 // The quasistatic incremental potential of one pseudo time step (DESIGN.md §4):
-//   E(x) = 1/(2Δt²)‖x − xᵗ‖²_M + Σ Ψ_membrane(x) + Σ Ψ_bending(x) − f·x.
+//   E(x) = 1/(2Δt²)‖x − xᵗ‖²_M + Σ Ψ_membrane(x) + Σ Ψ_bending(x) − f·x + Σ_terms T(x),
+// where the added terms (PotentialTerm) are the contact barrier, the kinematic pull of scripted
+// vertices and, later, friction and strain limiting.
 
+#include <vector>
+
+#include "engine/sim/potential_term.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "engine/solver/objective.hpp"
 
@@ -13,12 +18,24 @@ class IncrementalPotential : public Objective {
 
   /// The previous step's positions xᵗ, the centre of the inertia-like term.
   void set_previous(const Eigen::VectorXd& previous) { previous_ = previous; }
+  /// 1/Δt², the weight of the inertia-like term.
+  [[nodiscard]] double inertia_weight() const { return inertia_weight_; }
+
+  /// Adds a term to the sum. The potential does not own it: the term must outlive the potential
+  /// or be removed first.
+  void add_term(PotentialTerm& term);
+  void remove_term(const PotentialTerm& term);
 
   [[nodiscard]] Eigen::Index size() const override { return previous_.size(); }
   double value(const Eigen::VectorXd& x) override;
   void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
+  /// Batches: membrane and bending per shell, then one per added term.
   void hessian(const Eigen::VectorXd& x, HessianBlocks& H) override;
+  /// The smallest feasible step of the added terms (1 without terms).
+  double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) override;
 
+  /// ∇ of the inertia, elastic and external parts alone, without the added terms.
+  void base_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const;
   /// Elastic energy alone (membrane plus bending), for reports.
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const;
 
@@ -26,6 +43,7 @@ class IncrementalPotential : public Objective {
   const ShellSystem& system_;
   double inertia_weight_;  ///< 1/Δt²
   Eigen::VectorXd previous_;
+  std::vector<PotentialTerm*> terms_;
 };
 
 }  // namespace psq

@@ -2,40 +2,185 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
 #include "engine/core/error.hpp"
 
 namespace psq {
+namespace {
+
+/// Penalty stiffness k of the first pull round, its growth per round and the rounds tried
+/// before a frame gives up on reaching its targets (the scripted vertices then stay where the
+/// last round left them, a safe state, and the next frame tries again).
+constexpr double kInitialPullStiffness = 1e4;
+constexpr double kPullGrowth = 100.0;
+constexpr int kMaxPullRounds = 6;
+
+/// With contact, Newton runs in chunks of this many iterations with IPC's κ update between
+/// them (the solver keeps its objective fixed within a call, so κ may only change between).
+constexpr int kStiffnessUpdateInterval = 10;
+
+/// Adds a solve to a frame's Newton record: iterations, history and times accumulate; the
+/// verdict and the final values are the last solve's.
+void append_solve(NewtonResult& frame, NewtonResult solve) {
+  const bool first = frame.history.empty();
+  solve.iterations += first ? 0 : frame.iterations;
+  solve.times += frame.times;
+  solve.wall_seconds += frame.wall_seconds;
+  solve.history.insert(solve.history.begin(), frame.history.begin(), frame.history.end());
+  frame = std::move(solve);
+}
+
+}  // namespace
 
 QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
     : system_(scene),
       potential_(system_, scene.time.step),
       dofs_(system_.rest_mesh().vertex_count(), system_.pinned_vertex_indices()),
-      x_(flat(system_.rest_mesh().vertices)) {
+      x_(flat(system_.rest_mesh().vertices)),
+      previous_(x_) {
   settings_.step_scale = scene.time.step;
   settings_.max_iterations = scene.solver.max_iterations;
   settings_.tolerance = scene.solver.tolerance.value_or(
       1e-4 * bounding_box_diagonal(system_.rest_mesh().vertices));
+  if (contact_enabled(scene)) {
+    contact_ = std::make_unique<ContactTerm>(system_);
+    potential_.add_term(*contact_);
+  }
+}
+
+void QuasistaticSimulation::begin_contact_frame(FrameRecord& record,
+                                                const NewtonSettings& settings,
+                                                const NewtonSolver::Progress& progress) {
+  contact_->potential().reset_stats();
+  Eigen::VectorXd base_gradient;
+  potential_.base_gradient(x_, base_gradient);
+  std::vector<bool> free(x_.size());
+  for (Eigen::Index i = 0; i < x_.size(); ++i) free[i] = dofs_.reduced(i) >= 0;
+  contact_->initialize_stiffness(x_, base_gradient, free, potential_.inertia_weight());
+  if (move_scripted_vertices_if_safe(record.time)) return;
+
+  // Pull the vertices whose targets moved; the others stay fixed.
+  Eigen::VectorXd target = x_;
+  system_.apply_pins(target, record.time);
+  std::vector<int> pulled, held;
+  std::vector<double> weights;
+  for (const PinnedVertex& p : system_.pinned()) {
+    if (target.segment<3>(3 * p.vertex) == x_.segment<3>(3 * p.vertex)) {
+      held.push_back(p.vertex);
+      continue;
+    }
+    pulled.push_back(p.vertex);
+    const double mass = std::max(system_.dof_masses()[3 * p.vertex], contact_->average_mass());
+    weights.push_back(potential_.inertia_weight() * mass);
+  }
+  pull_.set(std::move(pulled), target, std::move(weights));
+  potential_.add_term(pull_);
+  const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
+  pull_.set_stiffness(kInitialPullStiffness);
+  for (int round = 0; round < kMaxPullRounds; ++round) {
+    append_solve(record.newton, solve(pulled_dofs, settings, progress));
+    ++record.kinematic_rounds;
+    if (move_scripted_vertices_if_safe(record.time)) break;
+    pull_.set_stiffness(kPullGrowth * pull_.stiffness());
+  }
+  potential_.remove_term(pull_);
+}
+
+bool QuasistaticSimulation::move_scripted_vertices_if_safe(double time) {
+  Eigen::VectorXd target = x_;
+  system_.apply_pins(target, time);
+  const Eigen::VectorXd move = target - x_;
+  if (move.isZero(0.0)) return true;
+  if (potential_.max_feasible_step(x_, move) < 1.0 || !std::isfinite(potential_.value(target)))
+    return false;
+  x_ = std::move(target);
+  return true;
+}
+
+NewtonResult QuasistaticSimulation::solve(const DofMap& dofs, const NewtonSettings& settings,
+                                          const NewtonSolver::Progress& progress) {
+  if (!contact_) return newton_.minimize(potential_, x_, dofs, settings, progress);
+  NewtonResult total;
+  int done = 0;
+  const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
+    if (!progress) return;
+    NewtonIteration counted = it;  // numbered within the whole solve, across the chunks
+    counted.iteration += done;
+    progress(counted);
+  };
+  NewtonSettings chunk = settings;
+  while (true) {
+    chunk.max_iterations = std::min(kStiffnessUpdateInterval, settings.max_iterations - done);
+    NewtonResult part = newton_.minimize(potential_, x_, dofs, chunk, numbered);
+    done += part.iterations;
+    append_solve(total, std::move(part));
+    if (total.converged || done >= settings.max_iterations) return total;
+    contact_->update_stiffness(x_);
+  }
+}
+
+void QuasistaticSimulation::finish_contact_frame(FrameRecord& record) {
+  Eigen::VectorXd target = x_;
+  system_.apply_pins(target, record.time);
+  record.kinematic_offset = (target - x_).lpNorm<Eigen::Infinity>();
+  record.barrier_stiffness = contact_->stiffness();
+  record.contact = contact_->potential().stats();
 }
 
 FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   FrameRecord record;
   record.frame = frame_ + 1;
   record.time = record.frame * system_.scene().time.step;
-  potential_.set_previous(x_);
-  Eigen::VectorXd x = x_;
-  system_.apply_pins(x, record.time);
-  if (!std::isfinite(potential_.value(x)))
-    throw NumericalError(fmt::format(
-        "frame {}: moving the pinned vertices to their scripted positions inverts or degenerates "
-        "triangles next to them; use more frames (smaller steps of the motion)", record.frame));
+  const int resumed_iterations = std::exchange(resumed_iterations_, 0);
+  if (resumed_iterations == 0) previous_ = x_;
+  potential_.set_previous(previous_);
   const int frame_number = record.frame;
-  record.newton = newton_.minimize(potential_, x, dofs_, settings_, [&](const NewtonIteration& it) {
-    if (progress) progress(frame_number, it);
-  });
-  x_ = std::move(x);
+  NewtonSettings settings = settings_;
+  settings.max_iterations -= resumed_iterations;
+  const NewtonSolver::Progress counted_progress = [&](const NewtonIteration& it) {
+    if (!progress) return;
+    NewtonIteration counted = it;  // numbered within the whole frame, across a restore
+    counted.iteration += resumed_iterations;
+    progress(frame_number, counted);
+  };
+  // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
+  if (contact_) {
+    begin_contact_frame(record, settings, counted_progress);
+  } else {
+    system_.apply_pins(x_, record.time);
+    if (!std::isfinite(potential_.value(x_)))
+      throw NumericalError(fmt::format(
+          "frame {}: moving the pinned vertices to their scripted positions inverts or "
+          "degenerates triangles next to them; use more frames (smaller steps of the motion)",
+          record.frame));
+  }
+  append_solve(record.newton, solve(dofs_, settings, counted_progress));
+  if (contact_) finish_contact_frame(record);
+  record.newton.iterations += resumed_iterations;
   frame_ = record.frame;
   record.elastic_energy = potential_.elastic_energy(x_);
   return record;
+}
+
+void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
+                                    const Eigen::VectorXd& previous, int iterations_in_frame) {
+  const bool in_progress = iterations_in_frame > 0;
+  if (positions.size() != x_.size() || previous.size() != x_.size())
+    throw std::invalid_argument(fmt::format("restore: {} and {} values for {} unknowns",
+                                            positions.size(), previous.size(), x_.size()));
+  if (frame < (in_progress ? 1 : 0) || frame > frame_count())
+    throw std::invalid_argument(fmt::format("restore: frame {} outside [{}, {}]", frame,
+                                            in_progress ? 1 : 0, frame_count()));
+  if (iterations_in_frame < 0 || iterations_in_frame > settings_.max_iterations)
+    throw std::invalid_argument(fmt::format("restore: {} iterations done, the limit is {}",
+                                            iterations_in_frame, settings_.max_iterations));
+  x_ = positions;
+  previous_ = previous;
+  frame_ = in_progress ? frame - 1 : frame;
+  resumed_iterations_ = iterations_in_frame;
 }
 
 }  // namespace psq

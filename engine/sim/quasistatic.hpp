@@ -1,10 +1,20 @@
 #pragma once
 // Quasistatic stepping of a scene at one resolution: each frame moves the pinned vertices to
 // their scripted positions and minimizes the incremental potential with Newton.
+//
+// With contact (docs/contact.md), no accepted state may intersect, even while colliders and
+// pinned sets move: at a frame's start κ is chosen (IPC), then the scripted vertices move to
+// their targets directly when the CCD finds that move safe; otherwise they are freed and pulled
+// toward the targets by a penalty of growing stiffness (KinematicPull) while the CCD line search
+// keeps every iterate intersection-free, and they are pinned at the targets as soon as the rest
+// of the way is safe. The frame's solve follows with them fixed.
 
 #include <functional>
+#include <memory>
 
+#include "engine/sim/contact_term.hpp"
 #include "engine/sim/incremental_potential.hpp"
+#include "engine/sim/kinematic_pull.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "engine/solver/newton.hpp"
 
@@ -15,7 +25,17 @@ struct FrameRecord {
   int frame = 0;            ///< 1-based; frame 0 is the rest state
   double time = 0.0;        ///< frame · Δt
   double elastic_energy = 0.0;
+  /// Every Newton solve of the frame (pull rounds, the solve, re-solves after κ updates).
   NewtonResult newton;
+  // Contact scenes only (zero otherwise):
+  ContactStats contact;          ///< barrier and CCD work, with the skips
+  double barrier_stiffness = 0;  ///< κ at the end of the frame
+  /// Penalty solves that pulled scripted vertices toward targets a direct move could not reach
+  /// safely (0: moved directly).
+  int kinematic_rounds = 0;
+  /// Largest |coordinate| of a scripted vertex's distance from its target at the end [m]: 0
+  /// unless the targets could not be reached without intersecting.
+  double kinematic_offset = 0;
 };
 
 class QuasistaticSimulation {
@@ -27,23 +47,56 @@ class QuasistaticSimulation {
   explicit QuasistaticSimulation(const Scene& scene);
 
   [[nodiscard]] const ShellSystem& system() const { return system_; }
+  /// The state of the last solved frame; inside step() (e.g. in its progress callback), the
+  /// current Newton iterate of the frame being solved.
   [[nodiscard]] const Eigen::VectorXd& positions() const { return x_; }
+  /// xᵗ, the anchor of the incremental potential of the frame being (or last) solved.
+  [[nodiscard]] const Eigen::VectorXd& previous() const { return previous_; }
+  /// Frames solved so far.
   [[nodiscard]] int frame() const { return frame_; }
   [[nodiscard]] int frame_count() const { return system_.scene().time.frames; }
   [[nodiscard]] const NewtonSettings& newton_settings() const { return settings_; }
+  /// The contact term, or null when the scene has no contact.
+  [[nodiscard]] ContactTerm* contact() { return contact_.get(); }
 
   /// Solves the next frame. A frame that does not converge within the iteration limit is
   /// returned with newton.converged = false; numerical failures throw NumericalError.
   FrameRecord step(const Progress& progress = {});
 
+  /// Continues from a saved state, exactly as if the run had not stopped. With
+  /// `iterations_in_frame` = 0, frame `frame` is solved and `positions` is its result (the next
+  /// step() solves frame + 1 from it). Otherwise frame `frame` is in progress: `positions` is its
+  /// Newton iterate after `iterations_in_frame` iterations, and the next step() continues that
+  /// solve with xᵗ = `previous` and the iterations left of solver.max_iterations.
+  /// @throws std::invalid_argument when the sizes or the frame do not fit this simulation.
+  void restore(int frame, const Eigen::VectorXd& positions, const Eigen::VectorXd& previous,
+               int iterations_in_frame = 0);
+
  private:
+  /// κ at the frame's start, then the scripted vertices to their targets (directly or pulled).
+  void begin_contact_frame(FrameRecord& record, const NewtonSettings& settings,
+                           const NewtonSolver::Progress& progress);
+  /// Moves every scripted vertex to its target at `time` if that motion (the others held) is
+  /// intersection-free by the CCD and the energy stays finite; returns whether it moved.
+  bool move_scripted_vertices_if_safe(double time);
+  /// Newton on x_ over `dofs`; with contact, in chunks with IPC's κ update between them.
+  NewtonResult solve(const DofMap& dofs, const NewtonSettings& settings,
+                     const NewtonSolver::Progress& progress);
+  /// The frame's contact statistics.
+  void finish_contact_frame(FrameRecord& record);
+
   ShellSystem system_;
   IncrementalPotential potential_;
+  std::unique_ptr<ContactTerm> contact_;  ///< null when the scene has no contact
+  KinematicPull pull_;
   DofMap dofs_;
   NewtonSolver newton_;
   NewtonSettings settings_;
   Eigen::VectorXd x_;
+  Eigen::VectorXd previous_;
   int frame_ = 0;
+  /// Newton iterations already spent on frame_ + 1 before a restore (0: start it afresh).
+  int resumed_iterations_ = 0;
 };
 
 }  // namespace psq

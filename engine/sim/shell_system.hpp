@@ -22,11 +22,30 @@ struct ShellBlock {
   MeshTopology topology;
 };
 
+/// One collider's place in the concatenated system: its vertices follow after every shell's
+/// and are scripted (pinned) vertices without mass or elastic energy.
+struct ColliderBlock {
+  std::string name;
+  int first_vertex = 0;
+  int vertex_count = 0;
+  int first_triangle = 0;
+  int triangle_count = 0;
+  MeshTopology topology;
+};
+
 /// Pinned vertices and where their scripted motions take them.
 struct PinnedVertex {
   int vertex;
   Eigen::Vector3d rest;
   const std::vector<RigidMotion>* motions;
+  int group;  ///< index of the pinned set in its shell's `pins`; −1 for a collider vertex
+};
+
+/// One shell of a hierarchy level: its rest mesh and, per vertex, the index of the pinned set
+/// (into the scene shell's `pins`) that holds it, or a negative number for a free vertex.
+struct LevelShellMesh {
+  TriMesh rest;
+  std::vector<int> pin_group;
 };
 
 class ShellSystem {
@@ -34,6 +53,13 @@ class ShellSystem {
   /// Builds every shell's mesh, energies, masses, pins and loads. Throws InputError for
   /// selections that select nothing and for meshes that fail validation.
   explicit ShellSystem(const Scene& scene);
+  /// The system of one hierarchy level: the scene's shells (same order, materials and
+  /// motions) with the given rest meshes; each pinned vertex follows its set's motions from its
+  /// own rest position. External force is gravity on this level's masses; loads are selected
+  /// on the finest mesh only, so they are left out (the progressive solver applies the finest
+  /// external force through the prolongation).
+  /// @throws std::invalid_argument when the meshes or pin groups do not fit the scene.
+  ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells);
   // Pins point into scene_'s motions: the system stays where it was built.
   ShellSystem(const ShellSystem&) = delete;
   ShellSystem& operator=(const ShellSystem&) = delete;
@@ -41,6 +67,8 @@ class ShellSystem {
   [[nodiscard]] const Scene& scene() const { return scene_; }
   [[nodiscard]] const TriMesh& rest_mesh() const { return rest_; }
   [[nodiscard]] const std::vector<ShellBlock>& shells() const { return shells_; }
+  /// The colliders, whose vertices and triangles follow the shells' in rest_mesh().
+  [[nodiscard]] const std::vector<ColliderBlock>& colliders() const { return colliders_; }
   [[nodiscard]] const std::vector<MembraneEnergy>& membranes() const { return membranes_; }
   [[nodiscard]] const std::vector<BendingEnergy>& bendings() const { return bendings_; }
   /// Lumped mass per DOF (3n).
@@ -49,13 +77,23 @@ class ShellSystem {
   [[nodiscard]] const Eigen::VectorXd& external_force() const { return external_force_; }
   [[nodiscard]] const std::vector<PinnedVertex>& pinned() const { return pinned_; }
   [[nodiscard]] std::vector<int> pinned_vertex_indices() const;
+  /// Per vertex of shell `shell` (local numbering): the index of the pinned set holding it in
+  /// that shell's `pins`, or −1 when it is free.
+  [[nodiscard]] std::vector<int> pin_groups(int shell) const;
   /// Sets the pinned vertices of x to their scripted positions at `time`.
   void apply_pins(Eigen::VectorXd& x, double time) const;
 
  private:
+  /// Concatenates the shells' meshes (in scene order) with their energies, masses and gravity.
+  void add_shells(const std::vector<TriMesh>& meshes);
+  /// Appends the scene's colliders after the shells: rest mesh, zero mass and force, and every
+  /// collider vertex as a pinned vertex following the collider's motions.
+  void add_colliders();
+
   Scene scene_;
   TriMesh rest_;
   std::vector<ShellBlock> shells_;
+  std::vector<ColliderBlock> colliders_;
   std::vector<MembraneEnergy> membranes_;
   std::vector<BendingEnergy> bendings_;
   Eigen::VectorXd dof_masses_;

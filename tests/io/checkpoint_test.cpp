@@ -10,7 +10,7 @@
 #include <iterator>
 
 #include "engine/io/checkpoint.hpp"
-#include "engine/io/checksum.hpp"
+#include "engine/core/checksum.hpp"
 #include "io/sample_checkpoint.hpp"
 #include "support/test_paths.hpp"
 

@@ -243,7 +243,7 @@ TEST(SweepFile, TheDemoSweepExpandsToSixValidJobs) {
   EXPECT_EQ(sweep.name, "demo");
   ASSERT_EQ(sweep.jobs.size(), 6u);
   EXPECT_EQ(jobs::new_jobs(sweep).front().scene,
-            (test::source_dir() / "jobs/scenes/cantilever.toml").lexically_normal().string());
+            (test::source_dir() / "jobs/scenes/demo_strip.toml").lexically_normal().string());
 }
 
 }  // namespace

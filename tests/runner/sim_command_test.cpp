@@ -42,6 +42,51 @@ TEST(SimCommand, WritesEveryFrameAndASummary) {
   EXPECT_GT(summary["frames"][2]["elastic_energy"].get<double>(), 0.0);
 }
 
+TEST(SimCommand, LevelsRunsProgressivelyAndWritesEveryLevel) {
+  const auto dir = test::fresh_temp_dir("sim_levels");
+  std::string text = small_scene(2);  // finer, so that a coarser level has room
+  text.replace(text.find("edge_length = 0.04"), 18, "edge_length = 0.02");
+  const auto scene = test::write_file(dir / "sag.toml", text);
+  const auto result =
+      test::run_psq({"sim", scene.string(), "--out", (dir / "out").string(), "--levels", "2"});
+  ASSERT_EQ(result.exit_code, 0) << result.errors;
+  EXPECT_NE(result.errors.find("level 0/1 frame 1/2"), std::string::npos) << result.errors;
+  EXPECT_NE(result.errors.find("level 1/1 frame 2/2 (settling)"), std::string::npos)
+      << result.errors;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "level_0.obj"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "level_1.obj"));
+  std::ifstream in(dir / "out" / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  EXPECT_TRUE(summary["all_converged"].get<bool>());
+  EXPECT_EQ(summary["level_count"].get<int>(), 2);
+  ASSERT_EQ(summary["levels"].size(), 2u);
+  const auto& coarse = summary["levels"][0];
+  const auto& fine = summary["levels"][1];
+  EXPECT_LT(coarse["vertices"].get<int>(), fine["vertices"].get<int>());
+  EXPECT_EQ(fine["vertices"].get<int>(), summary["vertices"].get<int>());
+  for (const auto& level : summary["levels"]) {
+    EXPECT_TRUE(level["converged"].get<bool>());
+    EXPECT_GT(level["steps"].size(), 0u);
+    EXPECT_GE(level["seconds"].get<double>(), 0.0);
+    int iterations = 0;
+    for (const auto& step : level["steps"]) iterations += step["iterations"].get<int>();
+    EXPECT_EQ(level["iterations"].get<int>(), iterations);
+  }
+  // The coarse level previews frames 1 and 2 before settling; the finest level only settles.
+  EXPECT_FALSE(coarse["steps"][0]["settling"].get<bool>());
+  EXPECT_TRUE(fine["steps"][0]["settling"].get<bool>());
+  EXPECT_EQ(summary["frames"].size(), fine["steps"].size());
+}
+
+TEST(SimCommand, LevelsBelowOneIsAnInputError) {
+  const auto dir = test::fresh_temp_dir("sim_levels");
+  const auto scene = test::write_file(dir / "sag.toml", small_scene(1));
+  const auto result =
+      test::run_psq({"sim", scene.string(), "--out", (dir / "out").string(), "--levels", "0"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.errors.find("--levels must be at least 1"), std::string::npos) << result.errors;
+}
+
 TEST(SimCommand, BadSceneNamesFileLineAndKeyAndWritesNothing) {
   const auto dir = test::fresh_temp_dir("sim");
   std::string text = small_scene(2);

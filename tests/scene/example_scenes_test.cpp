@@ -152,5 +152,73 @@ TEST(ExampleScenes, CantileverClampsTwoColumnsAndLoadsTheTipLine) {
   for (int v : shell.loads[0]) EXPECT_NEAR(shell.mesh.vertices(v, 0), 0.1, 1e-12);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Contact scenes (simulated at CI size in tests/sim/contact_scenes_test.cpp)
+
+/// Lowest and highest z of a mesh.
+std::pair<double, double> z_range(const TriMesh& mesh) {
+  return {mesh.vertices.col(2).minCoeff(), mesh.vertices.col(2).maxCoeff()};
+}
+
+TEST(ExampleScenes, DrapeSphereHangsTheClothAboveAFixedBallWithFriction) {
+  const Scene scene = example("drape_sphere");
+  EXPECT_DOUBLE_EQ(scene.contact.friction, 0.3);
+  ASSERT_EQ(scene.colliders.size(), 1u);
+  EXPECT_TRUE(scene.colliders[0].motions.empty());
+  const TriMesh ball = build_shell_mesh(scene.colliders[0].mesh);
+  const TriMesh cloth = build(scene)[0].mesh;
+  // The ball's top lies 5 cm below the flat cloth, which covers it.
+  EXPECT_NEAR(z_range(cloth).first - z_range(ball).second, 0.05, 1e-3);
+  EXPECT_GT(cloth.vertices.col(0).maxCoeff(), ball.vertices.col(0).maxCoeff());
+}
+
+TEST(ExampleScenes, TwistWrapTurnsBothEndsInOppositeDirectionsWithSelfContact) {
+  const Scene scene = example("twist_wrap");
+  EXPECT_TRUE(scene.contact.self_contact);
+  ASSERT_EQ(scene.shells.size(), 1u);
+  const Shell& sheet = scene.shells[0];
+  EXPECT_DOUBLE_EQ(sheet.mesh.sheet.width, 1.0);
+  EXPECT_DOUBLE_EQ(sheet.mesh.sheet.height, 1.0);
+  ASSERT_EQ(sheet.pins.size(), 2u);
+  const double end = scene.time.step * scene.time.frames;
+  // A quarter of the way, the ends have turned ±90°: (x, 0.5, 0) goes to (x', 0, ±0.5).
+  const Eigen::Vector3d left = apply_motions(sheet.pins[0].motions, {-0.5, 0.5, 0}, 0.25 * end);
+  const Eigen::Vector3d right = apply_motions(sheet.pins[1].motions, {0.5, 0.5, 0}, 0.25 * end);
+  EXPECT_NEAR(left.z(), 0.5, 1e-9);
+  EXPECT_NEAR(right.z(), -0.5, 1e-9);
+  // At the end, a full turn each, the ends are back in place, 5 cm further in.
+  EXPECT_LT((apply_motions(sheet.pins[0].motions, {-0.5, 0.5, 0}, end) -
+             Eigen::Vector3d(-0.45, 0.5, 0)).norm(), 1e-9);
+}
+
+TEST(ExampleScenes, CylinderCrushIsAThinAluminiumCanUnderADescendingPlate) {
+  const Scene scene = example("cylinder_crush");
+  const Material& can = scene.shells[0].material;
+  EXPECT_EQ(can.youngs_modulus, 69e9);
+  EXPECT_EQ(can.poisson_ratio, 0.33);
+  EXPECT_EQ(can.thickness, 1e-4);
+  ASSERT_EQ(scene.colliders.size(), 1u);
+  const TriMesh plate = build_shell_mesh(scene.colliders[0].mesh);
+  const double top = z_range(build(scene)[0].mesh).second;
+  EXPECT_GT(z_range(plate).first, top);  // the plate starts above the can
+  const Eigen::Vector3d corner = plate.vertices.row(0);
+  const double end = scene.time.step * scene.time.frames;
+  EXPECT_LT(apply_motions(scene.colliders[0].motions, corner, end).z(), top - 0.02);
+}
+
+TEST(ExampleScenes, BunnyPressUsesTheVendoredBunnyAboveTheSheet) {
+  const Scene scene = example("bunny_press");
+  ASSERT_EQ(scene.colliders.size(), 1u);
+  EXPECT_EQ(scene.colliders[0].mesh.file, test::source_dir() / "jobs" / "data" / "bunny.obj");
+  const TriMesh bunny = build_shell_mesh(scene.colliders[0].mesh);
+  EXPECT_EQ(bunny.vertex_count(), 1839);
+  EXPECT_EQ(bunny.triangle_count(), 3674);
+  validate_mesh(bunny, "bunny");
+  // Feet 1 cm above the flat sheet, about 0.3 m across.
+  EXPECT_NEAR(z_range(bunny).first, 0.01, 1e-3);
+  EXPECT_NEAR(bunny.vertices.col(0).maxCoeff() - bunny.vertices.col(0).minCoeff(), 0.3, 0.01);
+  EXPECT_EQ(z_range(build(scene)[0].mesh).second, 0.0);
+}
+
 }  // namespace
 }  // namespace psq

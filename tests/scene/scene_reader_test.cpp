@@ -1,6 +1,9 @@
 #include "engine/scene/scene_reader.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <tuple>
 
 #include "engine/core/error.hpp"
 #include "support/test_paths.hpp"
@@ -496,6 +499,171 @@ TEST(ReadScene, RepeatedNamesAreInputErrors) {
     const std::string message = e.what();
     EXPECT_NE(message.find("shells.toml:24: shell name 'sheet' is used twice"), std::string::npos)
         << message;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contact and colliders
+
+constexpr const char* kShellLines = R"([[shell]]
+name = "cloth"
+mesh = { generator = "sheet", width = 1, height = 1, edge_length = 0.1 }
+material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3 }
+)";  // lines 1..4
+
+TEST(ReadScene, ReadsContactSettingsAndCollidersAsWritten) {
+  const fs::path dir = test::fresh_temp_dir("read_contact");
+  const Scene scene = read_scene(test::write_file(dir / "contact.toml", std::string(kShellLines) + R"(
+[contact]
+enabled = true
+self_contact = true
+activation_distance = 2e-3
+thickness = 1e-4
+stiffness = 1e5
+friction = 0.4
+skip_when_apart = false
+ccd = { rescaling = 0.8, ratio_bound = 0.999, max_iterations = 500 }
+
+[[collider]]
+name = "ball"
+mesh = { generator = "sphere", radius = 0.3, edge_length = 0.05 }
+placement = { translation = [0, 0, -0.4] }
+
+[[collider]]
+name = "plate"
+mesh = { generator = "sheet", width = 2, height = 2, edge_length = 0.5 }
+
+[[collider.motion]]
+start = 0.5
+end = 1.5
+translation = [0, 0, -0.2]
+)"));
+  const ContactSettings& contact = scene.contact;
+  EXPECT_EQ(contact.enabled, std::optional<bool>(true));
+  EXPECT_TRUE(contact.self_contact);
+  EXPECT_EQ(contact.activation_distance, std::optional<double>(2e-3));
+  EXPECT_EQ(contact.thickness, 1e-4);
+  EXPECT_EQ(contact.stiffness, std::optional<double>(1e5));
+  EXPECT_EQ(contact.friction, 0.4);
+  EXPECT_FALSE(contact.skip_when_apart);
+  EXPECT_EQ(contact.ccd_rescaling, 0.8);
+  EXPECT_EQ(contact.ccd_ratio_bound, 0.999);
+  EXPECT_EQ(contact.ccd_max_iterations, 500);
+  ASSERT_EQ(scene.colliders.size(), 2u);
+  EXPECT_EQ(scene.colliders[0].name, "ball");
+  EXPECT_EQ(scene.colliders[0].mesh.kind, MeshSource::Kind::Sphere);
+  EXPECT_EQ(scene.colliders[0].mesh.sphere.radius, 0.3);
+  expect_vector(scene.colliders[0].mesh.translation, {0, 0, -0.4});
+  EXPECT_TRUE(scene.colliders[0].motions.empty());
+  EXPECT_EQ(scene.colliders[1].mesh.kind, MeshSource::Kind::Sheet);
+  ASSERT_EQ(scene.colliders[1].motions.size(), 1u);
+  EXPECT_EQ(scene.colliders[1].motions[0].start_time, 0.5);
+  expect_vector(scene.colliders[1].motions[0].translation, {0, 0, -0.2});
+}
+
+TEST(ReadScene, ContactDefaultsLeaveTheChoicesToTheSimulation) {
+  const fs::path dir = test::fresh_temp_dir("contact_defaults");
+  const Scene scene = read_scene(test::write_file(dir / "plain.toml", kShellLines));
+  const ContactSettings defaults;
+  EXPECT_FALSE(scene.contact.enabled.has_value());
+  EXPECT_FALSE(scene.contact.self_contact);
+  EXPECT_FALSE(scene.contact.activation_distance.has_value());
+  EXPECT_FALSE(scene.contact.stiffness.has_value());
+  EXPECT_EQ(scene.contact.thickness, 0.0);
+  EXPECT_EQ(scene.contact.friction, 0.0);
+  EXPECT_TRUE(scene.contact.skip_when_apart);
+  EXPECT_EQ(scene.contact.ccd_rescaling, defaults.ccd_rescaling);
+  EXPECT_EQ(scene.contact.ccd_ratio_bound, defaults.ccd_ratio_bound);
+  EXPECT_TRUE(scene.colliders.empty());
+}
+
+TEST(ReadScene, BadContactAndColliderEntriesNameTheirFileLineAndKey) {
+  const fs::path dir = test::fresh_temp_dir("bad_contact");
+  // Each text is appended after the shell (lines 1..4), so its first line is line 5.
+  const std::vector<std::tuple<std::string, int, std::string>> cases = {
+      {"[contact]\nactivation_distance = 0", 6, "'activation_distance' in [contact]"},
+      {"[contact]\nthickness = -1e-3", 6, "'thickness' in [contact]"},
+      {"[contact]\nstiffness = -5", 6, "'stiffness' in [contact]"},
+      {"[contact]\nfriction = -0.1", 6, "'friction' in [contact]"},
+      {"[contact]\nself_contact = 1", 6, "true or false"},
+      {"[contact]\nfrcition = 0.3", 6, "did you mean 'friction'?"},
+      {"[contact]\nccd = { ratio_bound = 1.5 }", 6, "'ratio_bound' in [contact.ccd]"},
+      {"[contact]\nccd = { max_iterations = 0 }", 6, "'max_iterations' in [contact.ccd]"},
+      {"[[collider]]\nname = \"ball\"", 5, "missing required table 'mesh' in [collider]"},
+      {"[[collider]]\nname = \"cloth\"\nmesh = { generator = \"sphere\", radius = 1, "
+       "edge_length = 0.5 }",
+       6, "shell or collider name 'cloth' is used twice"},
+      {"[[collider]]\nname = \"ball\"\nmesh = { generator = \"sphere\", radius = 1, "
+       "edge_length = 0.5 }\nmass = 3",
+       8, "unknown key 'mass' in [collider]"},
+      {"[[collider]]\nname = \"ball\"\nmesh = { generator = \"sphere\", radius = 1, "
+       "edge_length = 0.5 }\n[[collider.motion]]\nstart = 1\nend = 0",
+       10, "'end' in [collider.motion]"},
+  };
+  int index = 0;
+  for (const auto& [text, line, fragment] : cases) {
+    const fs::path path =
+        test::write_file(dir / fmt::format("case{}.toml", index++), std::string(kShellLines) + text + "\n");
+    try {
+      read_scene(path);
+      ADD_FAILURE() << "no error for:\n" << text;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind(fmt::format("{}:{}: ", path.string(), line), 0), 0u) << message;
+      EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+    }
+  }
+}
+
+TEST(ReadScene, ReadsTheHierarchyTableAndItsDefaults) {
+  const fs::path dir = test::fresh_temp_dir("read_hierarchy");
+  const Scene plain = read_scene(test::write_file(dir / "plain.toml", kShellLines));
+  EXPECT_EQ(plain.hierarchy.levels, 1);
+  EXPECT_EQ(plain.hierarchy.vertex_ratio, 0.25);
+  EXPECT_FALSE(plain.hierarchy.preview_tolerance.has_value());
+  EXPECT_EQ(plain.hierarchy.preview_iterations, 8);
+  EXPECT_FALSE(plain.hierarchy.refine_frame.has_value());
+
+  const Scene scene = read_scene(test::write_file(dir / "hierarchy.toml", std::string(kShellLines) + R"(
+[time]
+frames = 12
+[hierarchy]
+levels = 3
+vertex_ratio = 0.3
+preview_tolerance = 2e-3
+preview_iterations = 5
+refine_frame = 7
+)"));
+  EXPECT_EQ(scene.hierarchy.levels, 3);
+  EXPECT_EQ(scene.hierarchy.vertex_ratio, 0.3);
+  EXPECT_EQ(scene.hierarchy.preview_tolerance, 2e-3);
+  EXPECT_EQ(scene.hierarchy.preview_iterations, 5);
+  EXPECT_EQ(scene.hierarchy.refine_frame, 7);
+}
+
+TEST(ReadScene, BadHierarchyEntriesNameTheirFileLineAndKey) {
+  const fs::path dir = test::fresh_temp_dir("bad_hierarchy");
+  // Each line follows the shell (lines 1..4), [time] and [hierarchy]: it is line 8.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"levels = 0", "'levels' in [hierarchy] must be at least 1"},
+      {"vertex_ratio = 1", "'vertex_ratio' in [hierarchy] must be in (0, 1)"},
+      {"preview_tolerance = 0", "'preview_tolerance' in [hierarchy] must be positive"},
+      {"preview_iterations = 0", "'preview_iterations' in [hierarchy] must be at least 1"},
+      {"refine_frame = 4", "'refine_frame' in [hierarchy] must be a frame in 1..3"},
+      {"levles = 2", "did you mean 'levels'?"},
+  };
+  int index = 0;
+  for (const auto& [line, fragment] : cases) {
+    const std::string text = std::string(kShellLines) + "[time]\nframes = 3\n[hierarchy]\n" + line + "\n";
+    const fs::path path = test::write_file(dir / fmt::format("case{}.toml", index++), text);
+    try {
+      read_scene(path);
+      ADD_FAILURE() << "no error for: " << line;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind(fmt::format("{}:8: ", path.string()), 0), 0u) << message;
+      EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+    }
   }
 }
 

@@ -2,7 +2,7 @@
 
 #include <string_view>
 
-#include "engine/io/checksum.hpp"
+#include "engine/core/checksum.hpp"
 
 namespace psq {
 namespace {

@@ -1,4 +1,4 @@
-#include "engine/io/checksum.hpp"
+#include "engine/core/checksum.hpp"
 
 namespace psq {
 

@@ -1,0 +1,264 @@
+#include "engine/contact/contact_potential.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "engine/contact/edge_edge_distance.hpp"
+#include "engine/contact/edge_edge_mollifier.hpp"
+#include "engine/contact/point_triangle_distance.hpp"
+#include "engine/core/error.hpp"
+#include "engine/core/psd_projection.hpp"
+#include "engine/solver/solver_stats.hpp"
+
+namespace psq {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+using Gradient12 = Eigen::Matrix<double, 12, 1>;
+
+Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
+
+/// The four stencil positions of a pair.
+PairPositions stencil_positions(const std::array<int, 4>& vertices, const Eigen::VectorXd& x) {
+  return {vertex_of(x, vertices[0]), vertex_of(x, vertices[1]), vertex_of(x, vertices[2]),
+          vertex_of(x, vertices[3])};
+}
+
+double pair_distance(const ContactPair& pair, const Eigen::VectorXd& x) {
+  const PairPositions p = stencil_positions(pair.vertices, x);
+  return pair.edge_edge ? edge_edge_distance(p[0], p[1], p[2], p[3])
+                        : point_triangle_distance(p[0], p[1], p[2], p[3]);
+}
+
+/// m(c) b(d − ξ²) of one pair (m = 1 for point–triangle), +∞ within the thickness.
+double pair_value(const ContactPair& pair, const Eigen::VectorXd& x, const BarrierBand& band) {
+  const double s = band.barrier_argument(pair_distance(pair, x));
+  if (!(s > 0)) return kInfinity;
+  const double b = barrier(s, band.barrier_activation());
+  if (!pair.edge_edge || b == 0) return b;
+  const PairPositions p = stencil_positions(pair.vertices, x);
+  const double c = (p[1] - p[0]).cross(p[3] - p[2]).squaredNorm();
+  return edge_edge_mollifier(c, pair.mollifier_threshold) * b;
+}
+
+/// Value, gradient and Hessian of m b for one pair (κ = 1), by the product rule
+///   ∇(m b) = m ∇b + b ∇m,   ∇²(m b) = m ∇²b + b ∇²m + ∇m ∇bᵀ + ∇b ∇mᵀ.
+StencilDerivatives<12> pair_derivatives(const ContactPair& pair, const Eigen::VectorXd& x,
+                                        const BarrierBand& band) {
+  const PairPositions p = stencil_positions(pair.vertices, x);
+  if (!pair.edge_edge)
+    return barrier_of_distance(point_triangle_distance_derivatives(p[0], p[1], p[2], p[3]), band);
+  const StencilDerivatives<12> b =
+      barrier_of_distance(edge_edge_distance_derivatives(p[0], p[1], p[2], p[3]), band);
+  const StencilDerivatives<12> m =
+      edge_edge_mollifier(p[0], p[1], p[2], p[3], pair.mollifier_threshold);
+  StencilDerivatives<12> product;
+  product.value = m.value * b.value;
+  product.gradient = m.value * b.gradient + b.value * m.gradient;
+  product.hessian = m.value * b.hessian + b.value * m.hessian +
+                    m.gradient * b.gradient.transpose() + b.gradient * m.gradient.transpose();
+  return product;
+}
+
+/// The candidates as stencils, point–triangle pairs first (mollifier thresholds not set).
+std::vector<ContactPair> pairs_of(const ContactCandidates& candidates,
+                                  const ContactSurface& surface) {
+  std::vector<ContactPair> pairs;
+  pairs.reserve(candidates.size());
+  for (const PointTriangleCandidate& c : candidates.point_triangle) {
+    const auto t = surface.triangles.row(c.triangle);
+    pairs.push_back({{c.vertex, t[0], t[1], t[2]}, false, 0.0});
+  }
+  for (const EdgeEdgeCandidate& c : candidates.edge_edge) {
+    const auto& a = surface.edges[c.edge0];
+    const auto& b = surface.edges[c.edge1];
+    pairs.push_back({{a[0], a[1], b[0], b[1]}, true, 0.0});
+  }
+  return pairs;
+}
+
+void check_parameters(const ContactParameters& parameters) {
+  const BarrierBand& band = parameters.band;
+  if (!(band.activation_distance > 0) || !std::isfinite(band.activation_distance))
+    throw InputError(fmt::format("contact: the activation distance d̂ must be positive (got {})",
+                                 band.activation_distance));
+  if (!(band.thickness >= 0) || !std::isfinite(band.thickness))
+    throw InputError(
+        fmt::format("contact: the thickness ξ must be at least 0 (got {})", band.thickness));
+  validate_ccd_settings(parameters.ccd);
+}
+
+}  // namespace
+
+ContactStats& ContactStats::operator+=(const ContactStats& other) {
+  barrier_evaluations += other.barrier_evaluations;
+  barrier_skips += other.barrier_skips;
+  ccd_evaluations += other.ccd_evaluations;
+  ccd_skips += other.ccd_skips;
+  ccd_pair_queries += other.ccd_pair_queries;
+  max_active_pairs = std::max(max_active_pairs, other.max_active_pairs);
+  broad_phase_seconds += other.broad_phase_seconds;
+  barrier_seconds += other.barrier_seconds;
+  ccd_seconds += other.ccd_seconds;
+  return *this;
+}
+
+ContactPotential::ContactPotential(ContactSurface surface, const ContactParameters& parameters)
+    : surface_(std::move(surface)),
+      parameters_(parameters),
+      broad_phase_(surface_.triangles, surface_.edges, surface_.vertex_body, surface_.may_touch) {
+  parameters_.ccd.min_distance = parameters_.band.thickness;
+  check_parameters(parameters_);
+}
+
+double ContactPotential::reach() const {
+  return parameters_.band.thickness + parameters_.band.activation_distance;
+}
+
+void ContactPotential::refresh(const Eigen::VectorXd& x) {
+  if (cached_x_.size() == x.size() && cached_x_ == x) return;
+  ++stats_.barrier_evaluations;
+  // The early-out pays only when nothing is within reach; while the last state had pairs within
+  // reach, it would find one at once and the candidates would be searched a second time.
+  const bool try_skip = parameters_.skip_when_apart && active_.empty();
+  active_.clear();
+  min_distance_ = kInfinity;
+  cached_x_ = x;
+  const Eigen::Map<const Positions> positions = as_positions(x);
+  ContactCandidates candidates;
+  {
+    ScopedTimer timer(stats_.broad_phase_seconds);
+    if (try_skip && !broad_phase_.any_within_reach(positions, reach())) {
+      ++stats_.barrier_skips;
+      return;
+    }
+    candidates = broad_phase_.distance_candidates(positions, reach());
+  }
+  ScopedTimer timer(stats_.barrier_seconds);
+  std::vector<ContactPair> pairs = pairs_of(candidates, surface_);
+  std::vector<double> distance(pairs.size());
+  tbb::parallel_for(std::size_t{0}, pairs.size(),
+                    [&](std::size_t k) { distance[k] = pair_distance(pairs[k], x); });
+  const BarrierBand& band = parameters_.band;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    // NaN distances are kept: they make the value non-finite instead of vanishing silently.
+    if (band.barrier_argument(distance[k]) >= band.barrier_activation()) continue;
+    ContactPair& pair = pairs[k];
+    if (pair.edge_edge) {
+      const auto rest = [&](int slot) -> Eigen::Vector3d {
+        return surface_.rest.row(pair.vertices[slot]).transpose();
+      };
+      pair.mollifier_threshold = edge_edge_mollifier_threshold(rest(0), rest(1), rest(2), rest(3));
+    }
+    active_.push_back(pair);
+    min_distance_ = std::min(min_distance_, distance[k]);
+  }
+  stats_.max_active_pairs = std::max(stats_.max_active_pairs, static_cast<long>(active_.size()));
+}
+
+const std::vector<ContactPair>& ContactPotential::active_pairs(const Eigen::VectorXd& x) {
+  refresh(x);
+  return active_;
+}
+
+double ContactPotential::min_distance(const Eigen::VectorXd& x) {
+  refresh(x);
+  return min_distance_;
+}
+
+double ContactPotential::value(const Eigen::VectorXd& x) {
+  refresh(x);
+  if (active_.empty()) return 0.0;
+  ScopedTimer timer(stats_.barrier_seconds);
+  const double sum = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, active_.size()), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double partial) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+          partial += pair_value(active_[k], x, parameters_.band);
+        return partial;
+      },
+      std::plus<>());
+  return stiffness_ * sum;
+}
+
+void ContactPotential::accumulate_gradient(const Eigen::VectorXd& x, double scale,
+                                           Eigen::VectorXd& g) {
+  refresh(x);
+  if (active_.empty()) return;
+  ScopedTimer timer(stats_.barrier_seconds);
+  std::vector<Gradient12> gradients(active_.size());
+  tbb::parallel_for(std::size_t{0}, active_.size(), [&](std::size_t k) {
+    gradients[k] = pair_derivatives(active_[k], x, parameters_.band).gradient;
+  });
+  for (std::size_t k = 0; k < active_.size(); ++k)
+    for (int i = 0; i < 4; ++i)
+      g.segment<3>(3 * active_[k].vertices[i]) += scale * gradients[k].segment<3>(3 * i);
+}
+
+void ContactPotential::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+  accumulate_gradient(x, stiffness_, g);
+}
+
+Eigen::VectorXd ContactPotential::unit_gradient(const Eigen::VectorXd& x) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  accumulate_gradient(x, 1.0, g);
+  return g;
+}
+
+void ContactPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& blocks,
+                               bool project_psd) {
+  refresh(x);
+  std::vector<int> stencils;
+  stencils.reserve(4 * active_.size());
+  for (const ContactPair& pair : active_)
+    stencils.insert(stencils.end(), pair.vertices.begin(), pair.vertices.end());
+  blocks.reset(4, std::move(stencils));
+  ScopedTimer timer(stats_.barrier_seconds);
+  tbb::parallel_for(std::size_t{0}, active_.size(), [&](std::size_t k) {
+    Eigen::Matrix<double, 12, 12> h = pair_derivatives(active_[k], x, parameters_.band).hessian;
+    if (project_psd) project_to_psd(h);
+    blocks.block(k) = stiffness_ * h;
+  });
+}
+
+double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {
+  ++stats_.ccd_evaluations;
+  ScopedTimer timer(stats_.ccd_seconds);
+  const Eigen::Map<const Positions> start = as_positions(x);
+  const Positions end = start + as_positions(dx);
+  // Nothing comes within the barrier's reach on the way, so nothing can come within ξ. (With
+  // pairs within reach at the start, the early-out could not succeed: it is not tried.)
+  if (parameters_.skip_when_apart && active_pairs(x).empty() &&
+      !broad_phase_.any_within_reach_during(start, end, reach())) {
+    ++stats_.ccd_skips;
+    return 1.0;
+  }
+  const ContactCandidates candidates =
+      broad_phase_.swept_candidates(start, end, parameters_.band.thickness);
+  stats_.ccd_pair_queries += static_cast<long>(candidates.size());
+  const std::vector<ContactPair> pairs = pairs_of(candidates, surface_);
+  const Eigen::VectorXd x_end = x + dx;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, pairs.size()), 1.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double step) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+          const PairPositions p0 = stencil_positions(pairs[k].vertices, x);
+          const PairPositions p1 = stencil_positions(pairs[k].vertices, x_end);
+          const CcdResult hit = pairs[k].edge_edge ? edge_edge_ccd(p0, p1, parameters_.ccd)
+                                                   : point_triangle_ccd(p0, p1, parameters_.ccd);
+          step = std::min(step, hit.toi);
+        }
+        return step;
+      },
+      [](double a, double b) { return std::min(a, b); });
+}
+
+}  // namespace psq

@@ -1,0 +1,115 @@
+#pragma once
+// The IPC contact potential of a contact surface (Li et al. 2020): the barrier summed over
+// every point–triangle and edge–edge pair within reach, with its gradient, PSD-projected
+// Hessian blocks and the CCD-safe step of a line search.
+//
+//   B(x) = κ Σ_{point–triangle pairs} b(d(x) − ξ²) + κ Σ_{edge–edge pairs} m(c(x)) b(d(x) − ξ²)
+//
+// with d the squared pair distance (every closest-feature sub-case), b the barrier of
+// barrier.hpp (band ξ, d̂) and m the edge–edge mollifier (threshold from the rest positions).
+// Pairs sharing a vertex and pairs of bodies the surface's rule keeps apart never enter.
+//
+// Skips (DESIGN.md §4): with `skip_when_apart`, a state with no pair within reach costs one
+// early-out query (BroadPhase::any_within_reach) and no barrier work, and a step along which no
+// pair comes within reach costs one query (any_within_reach_during) and no CCD. Both are
+// counted in ContactStats.
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "engine/contact/additive_ccd.hpp"
+#include "engine/contact/barrier.hpp"
+#include "engine/contact/broad_phase.hpp"
+#include "engine/core/element_matrices.hpp"
+
+namespace psq {
+
+/// Every body of a simulation as one contact surface: shells and colliders concatenated.
+struct ContactSurface {
+  Triangles triangles;
+  std::vector<std::array<int, 2>> edges;  ///< unique edges, both ends in one body
+  std::vector<int> vertex_body;           ///< body id of every vertex, 0..B−1
+  BodyPairRule may_touch;                 ///< which bodies touch (self-contact: a == b)
+  Positions rest;                         ///< rest positions (edge–edge mollifier thresholds)
+};
+
+struct ContactParameters {
+  BarrierBand band;             ///< d̂ and ξ
+  AdditiveCcdSettings ccd;      ///< its min_distance is taken from band.thickness
+  bool skip_when_apart = true;  ///< use the early-outs (off only to measure what they save)
+};
+
+/// Work counters and times of a ContactPotential, for frame statistics and benchmarks.
+struct ContactStats {
+  long barrier_evaluations = 0;    ///< states whose active pairs were determined
+  long barrier_skips = 0;          ///< of those, states with no pair within reach (no barrier work)
+  long ccd_evaluations = 0;        ///< feasible-step queries
+  long ccd_skips = 0;              ///< of those, steps on which no pair came within reach (no CCD)
+  long ccd_pair_queries = 0;       ///< pair CCD queries run
+  long max_active_pairs = 0;       ///< the most pairs within reach at one state
+  double broad_phase_seconds = 0;  ///< early-outs and candidate searches of the barrier
+  double barrier_seconds = 0;      ///< distances, barrier values and derivatives
+  double ccd_seconds = 0;          ///< swept early-outs, swept candidates and pair CCD
+
+  ContactStats& operator+=(const ContactStats& other);
+};
+
+/// A pair within reach: point–triangle (p, t0, t1, t2) or edge–edge (a0, a1, b0, b1).
+struct ContactPair {
+  std::array<int, 4> vertices;
+  bool edge_edge = false;
+  double mollifier_threshold = 0;  ///< ε_x of an edge–edge pair
+};
+
+class ContactPotential {
+ public:
+  /// Throws InputError when d̂ is not positive, ξ is negative or a CCD setting is out of range.
+  ContactPotential(ContactSurface surface, const ContactParameters& parameters);
+
+  [[nodiscard]] const ContactParameters& parameters() const { return parameters_; }
+  [[nodiscard]] const BroadPhase& broad_phase() const { return broad_phase_; }
+  /// The distance within which pairs interact: ξ + d̂.
+  [[nodiscard]] double reach() const;
+
+  void set_stiffness(double kappa) { stiffness_ = kappa; }
+  [[nodiscard]] double stiffness() const { return stiffness_; }
+
+  /// B(x); +∞ when a pair is at or within the thickness (a state the line search rejects).
+  double value(const Eigen::VectorXd& x);
+  /// g += ∇B(x). Throws NumericalError at a penetrating state.
+  void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g);
+  /// ∇ of Σ b (κ = 1), for the initial stiffness.
+  Eigen::VectorXd unit_gradient(const Eigen::VectorXd& x);
+  /// Resets `blocks` to one 4-vertex block per pair within reach: κ·PSD(∇²(m b)), or κ ∇²(m b)
+  /// itself without `project_psd` (for derivative checks).
+  void hessian(const Eigen::VectorXd& x, ElementMatrices& blocks, bool project_psd = true);
+  /// The smallest squared distance of a pair within reach at x, +∞ when there is none.
+  double min_distance(const Eigen::VectorXd& x);
+  /// The pairs within reach at x (cached while x does not change).
+  const std::vector<ContactPair>& active_pairs(const Eigen::VectorXd& x);
+
+  /// The largest α ≤ 1 such that the linear motion x → x + α dx keeps every pair farther
+  /// apart than ξ: the minimum additive-CCD time of impact over the swept candidates (each
+  /// already conservative: the gap keeps at least ccd.ratio_bound of its start value).
+  double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx);
+
+  [[nodiscard]] const ContactStats& stats() const { return stats_; }
+  void reset_stats() { stats_ = ContactStats{}; }
+
+ private:
+  void refresh(const Eigen::VectorXd& x);
+  void accumulate_gradient(const Eigen::VectorXd& x, double scale, Eigen::VectorXd& g);
+
+  ContactSurface surface_;
+  ContactParameters parameters_;
+  BroadPhase broad_phase_;
+  double stiffness_ = 1.0;
+  ContactStats stats_;
+  // The active set of the last state asked about.
+  Eigen::VectorXd cached_x_;
+  std::vector<ContactPair> active_;
+  double min_distance_ = 0;
+};
+
+}  // namespace psq

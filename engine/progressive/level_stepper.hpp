@@ -1,0 +1,53 @@
+#pragma once
+// Quasistatic stepping at one level: each step moves the pinned vertices to their scripted
+// positions and minimizes the level's objective with Newton, starting from the previous step.
+
+#include <functional>
+#include <memory>
+
+#include "engine/progressive/level_objective.hpp"
+#include "engine/sim/quasistatic.hpp"
+#include "engine/solver/newton.hpp"
+
+namespace psq {
+
+/// Pseudo time step of settling step k = 0, 1, … (steps at one frame, loading held, until
+/// equilibrium): Δt·4^k, at most Δt·4^kSettlingGrowthSteps. A fixed Δt stalls in soft directions
+/// (each step moves them by their stiffness over M/Δt², so steps get small long before the
+/// equilibrium is reached); growing steps fade the inertia-like term.
+double settling_time_step(double time_step, int settle_step);
+inline constexpr int kSettlingGrowthSteps = 6;
+/// Settling ends at the first step taken at the largest time step whose change
+/// ‖x − xᵗ‖∞/Δt is below the tolerance: only then is a small change a small distance to the
+/// equilibrium.
+bool settling_done(int settle_step, double change, double tolerance);
+
+class LevelStepper {
+ public:
+  /// `system` is referenced (it must outlive the stepper); its pinned vertices are the fixed
+  /// DOFs. `settings.step_scale` should be the scene's Δt.
+  LevelStepper(const ShellSystem& system, std::unique_ptr<LevelObjective> objective,
+               const NewtonSettings& settings);
+
+  [[nodiscard]] const ShellSystem& system() const { return system_; }
+  [[nodiscard]] LevelObjective& objective() { return *objective_; }
+  [[nodiscard]] const NewtonSettings& settings() const { return settings_; }
+
+  /// One step to `frame` (time frame·Δt) from x, which becomes xᵗ; x is overwritten with the
+  /// result. A step that does not converge within settings().max_iterations is returned with
+  /// newton.converged = false.
+  /// @throws NumericalError when moving the pins makes the objective non-finite, or from Newton.
+  FrameRecord step(Eigen::VectorXd& x, int frame, const NewtonSolver::Progress& progress = {});
+  /// The same as a settling step: the inertia-like term uses `time_step` instead of Δt.
+  FrameRecord step(Eigen::VectorXd& x, int frame, double time_step,
+                   const NewtonSolver::Progress& progress = {});
+
+ private:
+  const ShellSystem& system_;
+  std::unique_ptr<LevelObjective> objective_;
+  DofMap dofs_;
+  NewtonSolver newton_;
+  NewtonSettings settings_;
+};
+
+}  // namespace psq

@@ -1,0 +1,229 @@
+#include "engine/progressive/progressive_simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "engine/core/error.hpp"
+
+namespace psq {
+namespace {
+
+/// How much coarser than the current (more refined) levels a preview tolerance defaults to.
+constexpr double kPreviewToleranceFactor = 10.0;
+
+void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
+  const auto fail = [&](const std::string& what) {
+    throw InputError(fmt::format("{}: [hierarchy] {}", scene.source.string(), what));
+  };
+  const HierarchyOptions& s = settings.schedule;
+  if (s.levels < 1) fail(fmt::format("levels must be at least 1 (got {})", s.levels));
+  if (!(s.vertex_ratio > 0 && s.vertex_ratio < 1))
+    fail(fmt::format("vertex_ratio must be in (0, 1) (got {})", s.vertex_ratio));
+  if (s.preview_iterations < 1)
+    fail(fmt::format("preview_iterations must be at least 1 (got {})", s.preview_iterations));
+  if (s.preview_tolerance && !(*s.preview_tolerance > 0))
+    fail(fmt::format("preview_tolerance must be positive (got {})", *s.preview_tolerance));
+  if (s.refine_frame && (*s.refine_frame < 1 || *s.refine_frame > scene.time.frames))
+    fail(fmt::format("refine_frame must be a frame in 1..{} (got {})", scene.time.frames,
+                     *s.refine_frame));
+  if (!scene.colliders.empty() || scene.contact.enabled.value_or(false) ||
+      scene.contact.self_contact)
+    fail("progressive simulation handles scenes without contact only (no [[collider]], "
+         "[contact] off); contact-safe refinement is not implemented yet");
+  if (settings.max_settle_steps < 1)
+    fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
+}
+
+/// The level of a shell's own hierarchy used at system level `level`: shells with fewer levels
+/// keep their coarsest mesh at the lowest system levels.
+int shell_level(const MeshHierarchy& hierarchy, int level, int level_count) {
+  return std::max(0, level - (level_count - hierarchy.level_count()));
+}
+
+}  // namespace
+
+ProgressiveSettings ProgressiveSettings::from_scene(const Scene& scene) {
+  ProgressiveSettings settings;
+  settings.schedule = scene.hierarchy;
+  return settings;
+}
+
+ProgressiveSimulation::ProgressiveSimulation(const Scene& scene,
+                                             const ProgressiveSettings& settings)
+    : settings_(settings), finest_(scene) {
+  check_settings(scene, settings_);
+  if (settings_.schedule.levels > 1) hierarchies_ = build_shell_hierarchies(finest_, settings_);
+  initialize();
+}
+
+ProgressiveSimulation::ProgressiveSimulation(const Scene& scene,
+                                             const ProgressiveSettings& settings,
+                                             std::vector<MeshHierarchy> hierarchies)
+    : settings_(settings), finest_(scene), hierarchies_(std::move(hierarchies)) {
+  check_settings(scene, settings_);
+  initialize();
+}
+
+ProgressiveSimulation::~ProgressiveSimulation() = default;
+
+void ProgressiveSimulation::initialize() {
+  const Scene& scene = finest_.scene();
+  if (!hierarchies_.empty() && hierarchies_.size() != finest_.shells().size())
+    throw std::invalid_argument(fmt::format("ProgressiveSimulation: {} hierarchies for {} shells",
+                                            hierarchies_.size(), finest_.shells().size()));
+  for (std::size_t s = 0; s < hierarchies_.size(); ++s) {
+    if (hierarchies_[s].levels.empty() ||
+        hierarchies_[s].finest().rest.vertex_count() != finest_.shells()[s].vertex_count)
+      throw std::invalid_argument(fmt::format(
+          "ProgressiveSimulation: the hierarchy of shell '{}' does not end at the shell's mesh",
+          finest_.shells()[s].name));
+    level_count_ = std::max(level_count_, hierarchies_[s].level_count());
+  }
+  refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
+  finest_tolerance_ = scene.solver.tolerance.value_or(
+      1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
+  preview_tolerance_ =
+      settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
+  build_prolongations();
+  enter_level(0);
+  x_ = flat(level_system().rest_mesh().vertices);
+  previous_ = x_;
+}
+
+void ProgressiveSimulation::build_prolongations() {
+  for (int level = 0; level + 1 < level_count_; ++level) {
+    std::vector<ShellProlongation> finest_maps, next_maps;
+    for (const MeshHierarchy& h : hierarchies_) {
+      const int here = shell_level(h, level, level_count_);
+      const int next = shell_level(h, level + 1, level_count_);
+      const TriMesh& rest = h.levels[here].rest;
+      finest_maps.push_back(here + 1 == h.level_count()
+                                ? identity_prolongation(rest)
+                                : ShellProlongation(rest, h.levels[here].finest,
+                                                    h.finest().rest.vertices));
+      next_maps.push_back(next == here ? identity_prolongation(rest)
+                                       : ShellProlongation(rest, h.levels[here].next_finer,
+                                                           h.levels[next].rest.vertices));
+    }
+    to_finest_.emplace_back(std::move(finest_maps));
+    to_next_.emplace_back(std::move(next_maps));
+  }
+}
+
+NewtonSettings ProgressiveSimulation::level_newton_settings(int level) const {
+  const Scene& scene = finest_.scene();
+  NewtonSettings newton;
+  newton.step_scale = scene.time.step;
+  const bool finest = level + 1 == level_count_;
+  newton.max_iterations =
+      finest ? scene.solver.max_iterations : settings_.schedule.preview_iterations;
+  newton.tolerance = finest ? finest_tolerance_ : preview_tolerance_;
+  return newton;
+}
+
+void ProgressiveSimulation::enter_level(int level) {
+  const Scene& scene = finest_.scene();
+  stepper_.reset();  // it refers to the level system replaced below
+  if (level + 1 == level_count_) {
+    coarse_system_.reset();
+    stepper_ = std::make_unique<LevelStepper>(
+        finest_, std::make_unique<DirectObjective>(finest_, scene.time.step),
+        level_newton_settings(level));
+  } else {
+    std::vector<LevelShellMesh> shells;
+    for (const MeshHierarchy& h : hierarchies_) {
+      const HierarchyLevel& shell = h.levels[shell_level(h, level, level_count_)];
+      shells.push_back({shell.rest, shell.pin_group});
+    }
+    coarse_system_ = std::make_unique<ShellSystem>(scene, shells);
+    stepper_ = std::make_unique<LevelStepper>(
+        *coarse_system_,
+        std::make_unique<ProxyObjective>(*coarse_system_, finest_, to_finest_[level],
+                                         scene.time.step, settings_.gradient),
+        level_newton_settings(level));
+  }
+  level_ = level;
+  settled_ = false;
+  level_converged_ = false;
+  settle_steps_ = 0;
+}
+
+const ShellSystem& ProgressiveSimulation::level_system() const { return stepper_->system(); }
+
+double ProgressiveSimulation::tolerance() const { return stepper_->settings().tolerance; }
+
+bool ProgressiveSimulation::level_done() const {
+  const int last_frame = level_ + 1 < level_count_ ? refine_frame_ : frame_count();
+  return frame_ == last_frame && (!settles() || settled_);
+}
+
+Eigen::VectorXd ProgressiveSimulation::finest_positions() const {
+  return level_ + 1 < level_count_ ? to_finest_[level_].apply(x_) : x_;
+}
+
+ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
+  if (level_done())
+    throw std::logic_error(fmt::format("ProgressiveSimulation::step: level {} is done", level_));
+  ProgressiveStep out;
+  out.level = level_;
+  out.settling = settles() && frame_ == refine_frame_ && !settled_;
+  const int frame = out.settling ? frame_ : frame_ + 1;
+  const double time_step = out.settling
+                               ? settling_time_step(finest_.scene().time.step, settle_steps_)
+                               : finest_.scene().time.step;
+  Eigen::VectorXd x = x_;
+  out.frame = stepper_->step(x, frame, time_step, [&](const NewtonIteration& it) {
+    if (progress) progress(level_, frame, it);
+  });
+  out.change = (x - x_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
+  previous_ = std::move(x_);
+  x_ = std::move(x);
+  frame_ = frame;
+  if (out.settling) {
+    level_converged_ = settling_done(settle_steps_, out.change, tolerance());
+    ++settle_steps_;
+    settled_ = level_converged_ || settle_steps_ >= settings_.max_settle_steps;
+  }
+  return out;
+}
+
+void ProgressiveSimulation::refine() {
+  if (level_ + 1 >= level_count_)
+    throw std::logic_error("ProgressiveSimulation::refine: already at the finest level");
+  if (!level_done())
+    throw std::logic_error(
+        fmt::format("ProgressiveSimulation::refine: level {} is not done", level_));
+  Eigen::VectorXd next = to_next_[level_].apply(x_);
+  enter_level(level_ + 1);
+  level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
+  x_ = std::move(next);
+  previous_ = x_;
+}
+
+void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd& positions,
+                                    const Eigen::VectorXd& previous) {
+  if (level < 0 || level >= level_count_)
+    throw std::invalid_argument(
+        fmt::format("ProgressiveSimulation::restore: level {} of {}", level, level_count_));
+  const int last_frame = level + 1 < level_count_ ? refine_frame_ : frame_count();
+  const int first_frame = level == 0 ? 0 : refine_frame_;
+  if (frame < first_frame || frame > last_frame)
+    throw std::invalid_argument(fmt::format(
+        "ProgressiveSimulation::restore: frame {} is outside level {}'s frames {}..{}", frame,
+        level, first_frame, last_frame));
+  enter_level(level);
+  const Eigen::Index size = level_system().rest_mesh().vertices.size();
+  if (positions.size() != size || previous.size() != size)
+    throw std::invalid_argument(fmt::format(
+        "ProgressiveSimulation::restore: level {} has {} unknowns, got {} positions and {} "
+        "previous", level, size, positions.size(), previous.size()));
+  x_ = positions;
+  previous_ = previous;
+  frame_ = frame;
+  settled_ = !settles() || frame > refine_frame_;
+  level_converged_ = settled_;
+}
+
+}  // namespace psq

@@ -1,0 +1,145 @@
+#pragma once
+// Progressive quasistatic simulation (paper §3, §4.5; DESIGN.md §6) of scenes without contact:
+// previews at the coarsest level over the loading script, then refinement level by level at the
+// refine frame, and the true objective at the finest level to convergence.
+//
+// Schedule, one quasistatic step per call of step():
+//   level 0 (levels > 1): frames 1..refine_frame with the proxy objective, at most
+//     preview_iterations Newton-type iterations per step; then "settling" steps at the refine
+//     frame (loading held, xᵗ ← x each step) until a step changes the solution by
+//     ‖x − xᵗ‖∞/Δt < preview_tolerance;
+//   refine(): x_{l+1} = P^l_{l+1}(x_l) with the pinned vertices set exactly (no contact: the
+//     target is the initializer);
+//   intermediate levels: settling steps at the refine frame as above;
+//   finest level: settling steps with the true incremental potential, each solved to the
+//     scene's tolerance, until the change is below that tolerance; then frames
+//     refine_frame+1..frames, one converged step each.
+// With levels = 1 the finest level steps frames 1..frames exactly like QuasistaticSimulation.
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "engine/hierarchy/mesh_hierarchy.hpp"
+#include "engine/progressive/level_stepper.hpp"
+#include "engine/progressive/proxy_objective.hpp"
+#include "engine/progressive/system_prolongation.hpp"
+
+namespace psq {
+
+struct ProgressiveSettings {
+  /// Levels, ratio, preview tolerance and iterations, refine frame (the scene's [hierarchy]).
+  HierarchyOptions schedule;
+  ProxyGradient gradient = ProxyGradient::exact;
+  /// Where built hierarchies are cached; empty: build without a cache.
+  std::filesystem::path cache_dir;
+  /// Settling steps per level before the level is given up as not converged.
+  int max_settle_steps = 200;
+
+  /// The scene's [hierarchy] settings, the default gradient, no cache.
+  static ProgressiveSettings from_scene(const Scene& scene);
+};
+
+/// One hierarchy per shell of `finest` (its meshes and pin groups), built with the schedule's
+/// levels and vertex ratio, through the cache in settings.cache_dir when that is set.
+std::vector<MeshHierarchy> build_shell_hierarchies(const ShellSystem& finest,
+                                                   const ProgressiveSettings& settings);
+
+/// One step of a progressive solve.
+struct ProgressiveStep {
+  int level = 0;
+  /// A step at the refine frame with the loading held (frame.frame does not advance).
+  bool settling = false;
+  double change = 0.0;  ///< ‖x − xᵗ‖∞/Δt of this step
+  /// Frame, time, fine-scale elastic energy (Ψ_L(P^l(x))), Newton history and timings.
+  FrameRecord frame;
+};
+
+class ProgressiveSimulation {
+ public:
+  /// Called for every Newton iteration (level, frame, record).
+  using Progress = std::function<void(int level, int frame, const NewtonIteration&)>;
+
+  /// Builds the finest system and, when settings.schedule.levels > 1, one hierarchy per shell
+  /// (pin groups from the shell's pinned sets; cached in settings.cache_dir when given).
+  /// @throws InputError for invalid settings (naming the setting).
+  ProgressiveSimulation(const Scene& scene, const ProgressiveSettings& settings);
+  /// The same with given hierarchies (one per shell, finest level = the shell's mesh). A shell
+  /// with fewer levels than the most refined one keeps its coarsest mesh at the lowest levels.
+  ProgressiveSimulation(const Scene& scene, const ProgressiveSettings& settings,
+                        std::vector<MeshHierarchy> hierarchies);
+  ~ProgressiveSimulation();
+  ProgressiveSimulation(const ProgressiveSimulation&) = delete;
+  ProgressiveSimulation& operator=(const ProgressiveSimulation&) = delete;
+
+  [[nodiscard]] int level_count() const { return level_count_; }
+  [[nodiscard]] int level() const { return level_; }
+  [[nodiscard]] int frame() const { return frame_; }
+  [[nodiscard]] int frame_count() const { return finest_.scene().time.frames; }
+  [[nodiscard]] int refine_frame() const { return refine_frame_; }
+  [[nodiscard]] bool level_done() const;
+  [[nodiscard]] bool finished() const { return level_ + 1 == level_count_ && level_done(); }
+  /// Whether the current level's settling met its tolerance (rather than max_settle_steps).
+  [[nodiscard]] bool level_converged() const { return level_converged_; }
+
+  /// Tolerance on ‖d‖∞/Δt (and on the settling change) at the current level.
+  [[nodiscard]] double tolerance() const;
+  /// The finest level's tolerance: the scene's, or 1e-4 × bounding-box diagonal per second.
+  [[nodiscard]] double finest_tolerance() const { return finest_tolerance_; }
+  [[nodiscard]] const ShellSystem& finest_system() const { return finest_; }
+  [[nodiscard]] const ShellSystem& level_system() const;
+  [[nodiscard]] const TriMesh& level_rest_mesh() const { return level_system().rest_mesh(); }
+  [[nodiscard]] const std::vector<MeshHierarchy>& hierarchies() const { return hierarchies_; }
+
+  /// Current positions of the current level (flat, 3n).
+  [[nodiscard]] const Eigen::VectorXd& positions() const { return x_; }
+  /// xᵗ: the positions the last step started from (equal to positions() before any step).
+  [[nodiscard]] const Eigen::VectorXd& previous() const { return previous_; }
+  /// P^l(x_l) on the finest mesh; positions() itself at the finest level.
+  [[nodiscard]] Eigen::VectorXd finest_positions() const;
+
+  /// One quasistatic step of the schedule. @throws std::logic_error when level_done().
+  ProgressiveStep step(const Progress& progress = {});
+  /// Moves to the next level from the current (done) one. @throws std::logic_error when the
+  /// level is not done or already the finest.
+  void refine();
+  /// Resumes from a stored state: `level`, the frame reached, the level's positions and xᵗ.
+  /// A level restored at its refine frame takes one more settling step before it counts as
+  /// done (the stored state does not say whether it had settled; a settled state passes that
+  /// step at once).
+  void restore(int level, int frame, const Eigen::VectorXd& positions,
+               const Eigen::VectorXd& previous);
+
+ private:
+  /// Validates the hierarchies, resolves the tolerances, enters level 0 at its rest state.
+  void initialize();
+  void build_prolongations();
+  /// Makes `level` the current level (its system, objective and stepper).
+  void enter_level(int level);
+  [[nodiscard]] NewtonSettings level_newton_settings(int level) const;
+  [[nodiscard]] bool settles() const { return level_count_ > 1; }
+
+  ProgressiveSettings settings_;
+  ShellSystem finest_;
+  std::vector<MeshHierarchy> hierarchies_;
+  int level_count_ = 1;
+  int refine_frame_ = 1;
+  double finest_tolerance_ = 0.0;
+  double preview_tolerance_ = 0.0;
+  /// Per level below the finest: P^l (to the finest mesh) and P^l_{l+1} (to the next level).
+  std::vector<SystemProlongation> to_finest_;
+  std::vector<SystemProlongation> to_next_;
+
+  int level_ = 0;
+  int frame_ = 0;
+  bool settled_ = false;
+  bool level_converged_ = false;
+  int settle_steps_ = 0;
+  std::unique_ptr<ShellSystem> coarse_system_;  ///< the current level's system below the finest
+  std::unique_ptr<LevelStepper> stepper_;
+  Eigen::VectorXd x_;
+  Eigen::VectorXd previous_;
+};
+
+}  // namespace psq

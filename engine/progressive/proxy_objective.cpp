@@ -1,0 +1,62 @@
+#include "engine/progressive/proxy_objective.hpp"
+
+namespace psq {
+namespace {
+
+double fine_elastics(const ShellSystem& finest, const Eigen::VectorXd& fine) {
+  double e = 0.0;
+  for (const auto& m : finest.membranes()) e += m.value(fine);
+  for (const auto& b : finest.bendings()) e += b.value(fine);
+  return e;
+}
+
+}  // namespace
+
+ProxyObjective::ProxyObjective(const ShellSystem& level, const ShellSystem& finest,
+                               const SystemProlongation& to_finest, double time_step,
+                               ProxyGradient gradient)
+    : level_(level),
+      finest_(finest),
+      to_finest_(to_finest),
+      inertia_weight_(1.0 / (time_step * time_step)),
+      gradient_kind_(gradient),
+      previous_(flat(level.rest_mesh().vertices)) {}
+
+double ProxyObjective::elastic_energy(const Eigen::VectorXd& x) const {
+  return fine_elastics(finest_, to_finest_.apply(x));
+}
+
+double ProxyObjective::value(const Eigen::VectorXd& x) {
+  const Eigen::VectorXd dx = x - previous_;
+  const double inertia = 0.5 * inertia_weight_ * dx.dot(level_.dof_masses().cwiseProduct(dx));
+  const Eigen::VectorXd fine = to_finest_.apply(x);
+  return inertia + fine_elastics(finest_, fine) - finest_.external_force().dot(fine);
+}
+
+Eigen::VectorXd ProxyObjective::fine_gradient(const Eigen::VectorXd& fine) const {
+  Eigen::VectorXd g = -finest_.external_force();
+  for (const auto& m : finest_.membranes()) m.add_gradient(fine, g);
+  for (const auto& b : finest_.bendings()) b.add_gradient(fine, g);
+  return g;
+}
+
+void ProxyObjective::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+  const Eigen::VectorXd fine_g = fine_gradient(to_finest_.apply(x));
+  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_);
+  if (gradient_kind_ == ProxyGradient::exact)
+    g += to_finest_.apply_jacobian_transpose(x, fine_g);
+  else
+    g += to_finest_.apply_linear_transpose(fine_g);
+}
+
+void ProxyObjective::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
+  H.diagonal = inertia_weight_ * level_.dof_masses();
+  const std::size_t shells = level_.membranes().size();
+  H.batches.resize(2 * shells);
+  for (std::size_t s = 0; s < shells; ++s) {
+    level_.membranes()[s].hessian(x, H.batches[2 * s]);
+    level_.bendings()[s].hessian(x, H.batches[2 * s + 1]);
+  }
+}
+
+}  // namespace psq

@@ -1,0 +1,56 @@
+#pragma once
+// The coarse-level proxy of the fine incremental potential (paper eqs. 2–3, §4.5):
+//   F(x_l) = 1/(2Δt²)‖x_l − x_lᵗ‖²_{M_l} + Ψ_L(P^l(x_l)) − f_L·P^l(x_l),
+// fine-scale elastics Ψ_L and external force f_L evaluated through the direct prolongation P^l,
+// level-l masses M_l. Newton-type steps use level l's own projected Hessian as preconditioner,
+//   H(x_l) = M_l/Δt² + PSD(∇²E_l(x_l)),
+// and either the exact gradient or the paper's eq.-10 gradient with the offsets held.
+
+#include "engine/progressive/level_objective.hpp"
+#include "engine/progressive/system_prolongation.hpp"
+#include "engine/sim/shell_system.hpp"
+
+namespace psq {
+
+/// Which gradient ProxyObjective::gradient returns.
+enum class ProxyGradient {
+  /// M_l(x − xᵗ)/Δt² + Uᵀ(∇Ψ_L − f_L)(P(x)): the prolongation's offsets held at their current
+  /// value (paper eq. 10). Not the gradient of F: the line search sees F itself.
+  held_offsets,
+  /// M_l(x − xᵗ)/Δt² + (∂P/∂x)ᵀ(∇Ψ_L − f_L)(P(x)): the gradient of F.
+  exact,
+};
+
+class ProxyObjective : public LevelObjective {
+ public:
+  /// `level`: the level's system (masses, pins, elastics for the preconditioner); `finest`: the
+  /// finest system (elastics and external force of the proxy); `to_finest`: P^l. All three are
+  /// referenced, not copied.
+  ProxyObjective(const ShellSystem& level, const ShellSystem& finest,
+                 const SystemProlongation& to_finest, double time_step, ProxyGradient gradient);
+
+  void set_previous(const Eigen::VectorXd& previous) override { previous_ = previous; }
+  void set_time_step(double time_step) override {
+    inertia_weight_ = 1.0 / (time_step * time_step);
+  }
+  /// Ψ_L(P^l(x)).
+  [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override;
+
+  [[nodiscard]] Eigen::Index size() const override { return previous_.size(); }
+  double value(const Eigen::VectorXd& x) override;
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
+  void hessian(const Eigen::VectorXd& x, HessianBlocks& H) override;
+
+ private:
+  /// ∇Ψ_L(y) − f_L at fine positions y.
+  [[nodiscard]] Eigen::VectorXd fine_gradient(const Eigen::VectorXd& fine) const;
+
+  const ShellSystem& level_;
+  const ShellSystem& finest_;
+  const SystemProlongation& to_finest_;
+  double inertia_weight_;  ///< 1/Δt²
+  ProxyGradient gradient_kind_;
+  Eigen::VectorXd previous_;
+};
+
+}  // namespace psq

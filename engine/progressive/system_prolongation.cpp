@@ -1,0 +1,77 @@
+#include "engine/progressive/system_prolongation.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace psq {
+namespace {
+
+/// The rows of shell block [first, first + count) of a flat position vector.
+Eigen::Map<const Positions> block_rows(const Eigen::VectorXd& x, int first, int count) {
+  return {x.data() + 3 * Eigen::Index(first), count, 3};
+}
+
+}  // namespace
+
+ShellProlongation identity_prolongation(const TriMesh& rest) {
+  std::vector<SurfaceLocation> locations(rest.vertex_count());
+  for (int t = 0; t < rest.triangle_count(); ++t)
+    for (int corner = 0; corner < 3; ++corner) {
+      SurfaceLocation& location = locations[rest.triangles(t, corner)];
+      if (location.triangle >= 0) continue;
+      location.triangle = t;
+      location.barycentric = Eigen::Vector3d::Unit(corner);
+    }
+  for (int v = 0; v < rest.vertex_count(); ++v)
+    if (locations[v].triangle < 0)
+      throw std::invalid_argument(
+          fmt::format("identity_prolongation: vertex {} is in no triangle", v));
+  return ShellProlongation(rest, std::move(locations), rest.vertices);
+}
+
+SystemProlongation::SystemProlongation(std::vector<ShellProlongation> shells) {
+  for (ShellProlongation& map : shells) {
+    const int coarse = map.coarse_vertex_count();
+    const int targets = map.target_count();
+    blocks_.push_back({std::move(map), coarse_vertices_, target_vertices_});
+    coarse_vertices_ += coarse;
+    target_vertices_ += targets;
+  }
+}
+
+Eigen::VectorXd SystemProlongation::apply(const Eigen::VectorXd& coarse) const {
+  Eigen::VectorXd out(target_size());
+  for (const Block& b : blocks_) {
+    const Positions prolonged =
+        b.map.apply(block_rows(coarse, b.first_coarse, b.map.coarse_vertex_count()));
+    out.segment(3 * Eigen::Index(b.first_target), prolonged.size()) = flat(prolonged);
+  }
+  return out;
+}
+
+Eigen::VectorXd SystemProlongation::apply_linear_transpose(const Eigen::VectorXd& g) const {
+  Eigen::VectorXd out(coarse_size());
+  for (const Block& b : blocks_) {
+    const Eigen::Index rows = 3 * Eigen::Index(b.map.target_count());
+    const Eigen::Index cols = 3 * Eigen::Index(b.map.coarse_vertex_count());
+    out.segment(3 * Eigen::Index(b.first_coarse), cols) =
+        b.map.linear_part().transpose() * g.segment(3 * Eigen::Index(b.first_target), rows);
+  }
+  return out;
+}
+
+Eigen::VectorXd SystemProlongation::apply_jacobian_transpose(const Eigen::VectorXd& coarse,
+                                                             const Eigen::VectorXd& g) const {
+  Eigen::VectorXd out(coarse_size());
+  for (const Block& b : blocks_) {
+    const Eigen::Index rows = 3 * Eigen::Index(b.map.target_count());
+    const Eigen::Index cols = 3 * Eigen::Index(b.map.coarse_vertex_count());
+    const Positions shell_coarse = block_rows(coarse, b.first_coarse, b.map.coarse_vertex_count());
+    out.segment(3 * Eigen::Index(b.first_coarse), cols) = b.map.apply_jacobian_transpose(
+        shell_coarse, g.segment(3 * Eigen::Index(b.first_target), rows));
+  }
+  return out;
+}
+
+}  // namespace psq

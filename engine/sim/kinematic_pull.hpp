@@ -1,0 +1,40 @@
+#pragma once
+// How scripted vertices (pinned shell sets, collider vertices) reach their targets safely when
+// contact is on. Moving them directly could push a collider through a shell, so when the CCD
+// says the direct move is not safe, they become unknowns pulled toward their targets by
+//   P(x) = ½ k Σᵢ wᵢ ‖xᵢ − yᵢ‖²,   wᵢ = mᵢ/Δt²,
+// and the solver's CCD line search keeps every iterate intersection-free (IPC's treatment of
+// kinematic boundary conditions, with a penalty of growing stiffness k in place of the
+// augmented Lagrangian's multipliers). Once the rest of the way is safe they are pinned at the
+// targets; see QuasistaticSimulation.
+
+#include <vector>
+
+#include "engine/sim/potential_term.hpp"
+
+namespace psq {
+
+class KinematicPull : public PotentialTerm {
+ public:
+  /// The vertices to pull, their targets (3 per vertex, in a vector of 3n like x) and weights.
+  void set(std::vector<int> vertices, const Eigen::VectorXd& targets, std::vector<double> weights);
+  void set_stiffness(double k) { stiffness_ = k; }
+  [[nodiscard]] double stiffness() const { return stiffness_; }
+  [[nodiscard]] const std::vector<int>& vertices() const { return vertices_; }
+  /// maxᵢ ‖xᵢ − yᵢ‖ over the pulled vertices (0 without any).
+  [[nodiscard]] double largest_offset(const Eigen::VectorXd& x) const;
+
+  double value(const Eigen::VectorXd& x) override;
+  void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
+  /// Diagonal only: k wᵢ on the three DOFs of each pulled vertex.
+  void hessian(const Eigen::VectorXd& x, Eigen::VectorXd& diagonal,
+               ElementMatrices& blocks) override;
+
+ private:
+  std::vector<int> vertices_;
+  Eigen::VectorXd targets_;
+  std::vector<double> weights_;
+  double stiffness_ = 1.0;
+};
+
+}  // namespace psq

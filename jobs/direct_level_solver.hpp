@@ -1,0 +1,71 @@
+#pragma once
+// The solvers a job can run, behind LevelSolver. Header-only on purpose: psq_jobs links the
+// scene, store and checkpoint modules but not the simulation (psq_sim), so the code that builds
+// a simulation lives in the translation units of the programs that link the engine (psq, its
+// tests and benchmarks), which include this header.
+
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "engine/core/error.hpp"
+#include "engine/sim/quasistatic.hpp"
+#include "jobs/level_solver.hpp"
+
+namespace psq::jobs {
+
+/// A direct solve as a hierarchy of one level: QuasistaticSimulation over the scene's frames.
+class DirectLevelSolver final : public LevelSolver {
+ public:
+  explicit DirectLevelSolver(const Scene& scene) : simulation_(scene) {}
+
+  int level_count() const override { return 1; }
+  int level() const override { return 0; }
+  int frame() const override { return simulation_.frame(); }
+  int frame_count() const override { return simulation_.frame_count(); }
+  bool level_done() const override { return simulation_.frame() == simulation_.frame_count(); }
+  bool finished() const override { return level_done(); }
+
+  LevelFrame step(const Progress& progress) override {
+    const FrameRecord record = simulation_.step(progress);
+    return {.level = 0,
+            .frame = record.frame,
+            .converged = record.newton.converged,
+            .iterations = record.newton.iterations,
+            .step_norm = record.newton.step_norm,
+            .gradient_norm = record.newton.gradient_norm,
+            .times = record.newton.times};
+  }
+
+  void refine() override {
+    throw std::logic_error("DirectLevelSolver::refine: a direct solve has one level");
+  }
+
+  const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
+  const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
+  const TriMesh& level_rest_mesh() const override { return simulation_.system().rest_mesh(); }
+  Positions finest_positions() const override { return as_positions(simulation_.positions()); }
+
+  void restore(int level, int frame, const Eigen::VectorXd& positions,
+               const Eigen::VectorXd& previous, int iterations_in_frame) override {
+    if (level != 0)
+      throw std::invalid_argument(fmt::format("restore: level {} of a direct solve", level));
+    simulation_.restore(frame, positions, previous, iterations_in_frame);
+  }
+
+ private:
+  QuasistaticSimulation simulation_;
+};
+
+/// The solver of a job with `depth` hierarchy levels on `scene`.
+/// @throws InputError for a depth the program cannot solve yet.
+inline std::unique_ptr<LevelSolver> make_level_solver(const Scene& scene, int depth) {
+  if (depth == 1) return std::make_unique<DirectLevelSolver>(scene);
+  // The progressive solver (engine/progressive) plugs in here for depth > 1.
+  throw InputError(
+      fmt::format("depth {}: depth > 1 needs the progressive solver, which this "
+                  "build does not include yet; use depth = 1",
+                  depth));
+}
+
+}  // namespace psq::jobs

@@ -1,0 +1,467 @@
+#include "jobs/job_executor.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iterator>
+
+#include "engine/io/checkpoint.hpp"
+#include "engine/core/checksum.hpp"
+#include "engine/io/xdmf.hpp"
+#include "engine/scene/scene_reader.hpp"
+#include "jobs/heartbeat.hpp"
+#include "jobs/job_identity.hpp"
+#include "jobs/run_directory.hpp"
+#include "jobs/scene_overrides.hpp"
+#include "jobs/test_hooks.hpp"
+
+namespace psq::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Unwinding signals, thrown from the Newton progress callback through the solver.
+struct StopRequested {};
+struct LeaseLost {};
+
+/// The store itself failed (disk full, I/O error, locked beyond the timeout): nothing can be
+/// recorded, so the worker stops and the job's lease expires.
+class StoreFailure : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+/// Runs a store call; its failures other than a lost lease become StoreFailure.
+template <class Call>
+auto through_store(const Call& call) {
+  try {
+    return call();
+  } catch (const db::LeaseLostError&) {
+    throw;
+  } catch (const std::exception& error) {
+    throw StoreFailure(error.what());
+  }
+}
+
+/// A frame that did not converge: the job's answer would be wrong, and rerunning it gives the
+/// same frame again, so the job fails for good.
+class NotConverged : public NumericalError {
+ public:
+  using NumericalError::NumericalError;
+};
+
+/// The job's scene: its file with its overrides. Throws InputError when the scene file changed
+/// since the sweep was added (the job's identity no longer describes it) or is now invalid.
+Scene job_scene(const db::Job& job) {
+  const std::string expected = job.parameters.value("scene", "");
+  const std::string actual = file_content_hash(job.scene);
+  if (actual != expected)
+    throw InputError(
+        fmt::format("{}: the scene file changed since the sweep was added ({} then, "
+                    "{} now); add the sweep again to run the edited scene",
+                    job.scene, expected, actual));
+  Overrides overrides;
+  const nlohmann::json stored = job.parameters.value("overrides", nlohmann::json::object());
+  for (const auto& [path, value] : stored.items()) overrides[path] = value;
+  try {
+    return apply_overrides(read_scene(job.scene), overrides);
+  } catch (const OverrideError& error) {
+    throw InputError(fmt::format("{}: parameter {}: {}", job.scene, error.path(), error.what()));
+  }
+}
+
+std::uint64_t file_checksum(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+  if (!in && !in.eof()) throw CheckpointError(fmt::format("cannot read '{}'", file.string()));
+  return fnv1a64(std::as_bytes(std::span(bytes)));
+}
+
+IterationRecord iteration_record(int frame, const NewtonIteration& it) {
+  return {.frame = frame,
+          .iteration = it.iteration,
+          .energy = it.energy,
+          .gradient_norm = it.gradient_norm,
+          .step_norm = it.step_norm,
+          .step_length = it.step_length,
+          .seconds = it.times.total()};
+}
+
+void add_phase_times(std::map<std::string, double>& timings, const PhaseTimes& times) {
+  timings["assembly"] += times.assembly;
+  timings["factorization"] += times.factorization;
+  timings["solve"] += times.solve;
+  timings["line_search"] += times.line_search;
+}
+
+/// One run of one claimed job: the state between the executor's steps.
+class JobRun {
+ public:
+  JobRun(db::JobStore& store, const fs::path& database, const fs::path& runs_dir,
+         const SolverFactory& factory, const ExecutorSettings& settings,
+         const ExecutorEvents& events, const std::atomic<bool>& stop, const db::Claim& claim)
+      : store_(store),
+        factory_(factory),
+        settings_(settings),
+        events_(events),
+        stop_(stop),
+        claim_(claim),
+        run_(runs_dir / claim.job.id),
+        heartbeat_(database, claim.lease) {}
+
+  RunOutcome run() {
+    try {
+      run_.create();
+    } catch (const InputError& error) {
+      throw environment_failure(error.what());
+    }
+    run_.remove_stale_temporaries();
+    try {
+      scene_ = job_scene(claim_.job);
+      solver_ = factory_(scene_, claim_.job.depth);
+      resume();
+      while (true) {
+        if (!solver_->level_done()) solve_level();  // a resumed level may be done already
+        if (solver_->finished()) break;
+        solver_->refine();
+        start_level();
+      }
+      test_point("before_finish");
+      through_store([&] { store_.finish(claim_.lease, db::Outcome::done); });
+      log(fmt::format("done in {:.1f} s", seconds_since(run_start_)));
+      return RunOutcome::done;
+    } catch (const StopRequested&) {
+      through_store([&] { return store_.release(claim_.lease); });
+      log("stopped on request: checkpoint written, job released");
+      return RunOutcome::interrupted;
+    } catch (const LeaseLost&) {
+      log("lease lost (cancelled, or reclaimed by another worker): stopped");
+      return RunOutcome::lease_lost;
+    } catch (const db::LeaseLostError&) {
+      log("lease lost (cancelled, or reclaimed by another worker): stopped");
+      return RunOutcome::lease_lost;
+    } catch (const WorkerEnvironmentError&) {
+      throw;
+    } catch (const StoreFailure&) {
+      throw;
+    } catch (const CheckpointError& error) {
+      throw environment_failure(error.what());
+    } catch (const NumericalError& error) {
+      return fail(db::Outcome::failed_permanently,
+                  fmt::format("numerical failure: {}", error.what()));
+    } catch (const InputError& error) {
+      return fail(db::Outcome::failed_permanently, error.what());
+    } catch (const std::exception& error) {
+      return fail(db::Outcome::failed, fmt::format("internal error: {}", error.what()));
+    }
+  }
+
+ private:
+  // ---- resuming ------------------------------------------------------------------------------
+
+  /// Continues from the most advanced checkpoint that verifies, or starts the job afresh.
+  void resume() {
+    const std::vector<db::JobResult> results =
+        through_store([&] { return store_.results(db::JobSelection::job(claim_.job.id)); });
+    const std::vector<db::LevelRecord> records =
+        results.empty() ? std::vector<db::LevelRecord>{} : results.front().levels;
+    for (const ResumeCandidate& candidate : resume_candidates(run_, claim_.job.depth, records)) {
+      try {
+        Checkpoint checkpoint = read_checkpoint(candidate.file, candidate.recorded_checksum);
+        if (checkpoint.parameters != claim_.job.parameters.dump())
+          throw CheckpointError(
+              fmt::format("{}: written for other parameters", candidate.file.string()));
+        const bool in_frame = checkpoint.solver.progress == LevelProgress::inside_frame;
+        solver_->restore(checkpoint.level, checkpoint.frame, flat(checkpoint.positions),
+                         flat(checkpoint.solver.previous_positions),
+                         in_frame ? checkpoint.solver.iterations_in_frame : 0);
+        if (in_frame) resumed_in_frame_ = {checkpoint.frame, checkpoint.solver.iterations_in_frame};
+        continue_from(candidate.file, std::move(checkpoint));
+        return;
+      } catch (const std::invalid_argument& error) {
+        log(fmt::format("{}: does not fit the job ({}); trying an earlier checkpoint",
+                        candidate.file.filename().string(), error.what()));
+      } catch (const CheckpointError& error) {
+        log(fmt::format("{}; trying an earlier checkpoint", error.what()));
+      }
+    }
+    start_level();
+  }
+
+  void continue_from(const fs::path& file, Checkpoint checkpoint) {
+    log(fmt::format("resuming level {} frame {} from {}", checkpoint.level, checkpoint.frame,
+                    file.filename().string()));
+    for (int level = 0; level < checkpoint.level; ++level) add_sidecar_entry(level);
+    statistics_ = std::move(checkpoint.statistics);
+    level_start_ = Clock::now();
+    since_checkpoint_ = Clock::now();
+    if (checkpoint.solver.progress == LevelProgress::level_done)
+      record_finished_level(file, file_checksum(file));
+  }
+
+  void start_level() {
+    statistics_ = {};
+    level_start_ = Clock::now();
+    since_checkpoint_ = Clock::now();
+    iterations_since_checkpoint_ = 0;
+    if (solver_->level_count() > 1)
+      log(fmt::format("level {}/{}: {} vertices", solver_->level(), solver_->level_count(),
+                      solver_->level_rest_mesh().vertex_count()));
+  }
+
+  // ---- solving -------------------------------------------------------------------------------
+
+  void solve_level() {
+    while (!solver_->level_done()) {
+      // A stop before the first step after an in-frame resume snapshots that frame again.
+      if (resumed_in_frame_)
+        stop_if_asked(LevelProgress::inside_frame, resumed_in_frame_->first,
+                      resumed_in_frame_->second);
+      else
+        stop_if_asked(LevelProgress::frame_done, solver_->frame(), 0);
+      const LevelFrame frame =
+          solver_->step([this](int frame, const NewtonIteration& it) { on_iteration(frame, it); });
+      resumed_in_frame_.reset();
+      if (!frame.converged)
+        throw NotConverged(fmt::format(
+            "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "
+            "{:.3e} at the end)",
+            frame.level, frame.frame, scene_.solver.max_iterations, frame.step_norm));
+      if (!solver_->level_done() && snapshot_due())
+        snapshot(LevelProgress::frame_done, solver_->frame(), 0);
+    }
+    const fs::path file = run_.level_checkpoint(solver_->level());
+    const std::uint64_t checksum =
+        write(file, make_checkpoint(LevelProgress::level_done, solver_->frame(), 0));
+    test_point("level_written");
+    record_finished_level(file, checksum);
+  }
+
+  void on_iteration(int frame, const NewtonIteration& it) {
+    statistics_.iterations.push_back(iteration_record(frame, it));
+    add_phase_times(statistics_.timings, it.times);
+    report_progress(frame, it);
+    test_point("iteration");
+    if (heartbeat_.lost()) throw LeaseLost{};
+    if (it.step_length <= 0.0) return;  // no step taken: the frame ends with this record
+    ++iterations_since_checkpoint_;
+    stop_if_asked(LevelProgress::inside_frame, frame, it.iteration + 1);
+    if (snapshot_due()) snapshot(LevelProgress::inside_frame, frame, it.iteration + 1);
+  }
+
+  void stop_if_asked(LevelProgress progress, int frame, int iterations_in_frame) {
+    if (heartbeat_.lost()) throw LeaseLost{};
+    if (!stop_.load()) return;
+    snapshot(progress, frame, iterations_in_frame);
+    throw StopRequested{};
+  }
+
+  bool snapshot_due() const {
+    return iterations_since_checkpoint_ >= settings_.snapshot_iterations ||
+           seconds_since(since_checkpoint_) >= settings_.snapshot_seconds;
+  }
+
+  void report_progress(int frame, const NewtonIteration& it) {
+    if (!events_.progress) return;
+    JobProgress progress;
+    progress.job_id = claim_.job.id;
+    progress.level = solver_->level();
+    progress.level_count = solver_->level_count();
+    progress.frame = frame;
+    progress.frame_count = solver_->frame_count();
+    progress.iteration = it.iteration;
+    progress.step_norm = it.step_norm;
+    progress.gradient_norm = it.gradient_norm;
+    const int solved = solver_->frame();
+    if (solved > 0) {
+      const double per_frame = level_seconds() / solved;
+      progress.eta_seconds = per_frame * (solver_->frame_count() - solved);
+    }
+    events_.progress(progress);
+  }
+
+  /// Wall time of the current level over all attempts so far.
+  double level_seconds() const {
+    const auto recorded = statistics_.timings.find("wall");
+    return (recorded == statistics_.timings.end() ? 0.0 : recorded->second) +
+           seconds_since(level_start_);
+  }
+
+  // ---- checkpoints and records ---------------------------------------------------------------
+
+  /// Writes level l's in-level snapshot, keeping the one before it, and records it.
+  void snapshot(LevelProgress progress, int frame, int iterations_in_frame) {
+    const int level = solver_->level();
+    const fs::path file = run_.snapshot(level);
+    std::error_code ignored;
+    if (fs::exists(file)) fs::rename(file, run_.previous_snapshot(level), ignored);
+    const std::uint64_t checksum =
+        write(file, make_checkpoint(progress, frame, iterations_in_frame));
+    test_point("snapshot_written");
+    record(db::LevelStatus::running, file, checksum);
+    test_point("snapshot_recorded");
+  }
+
+  void record_finished_level(const fs::path& file, std::uint64_t checksum) {
+    const int level = solver_->level();
+    record(db::LevelStatus::done, file, checksum);
+    test_point("level_recorded");
+    run_.remove_snapshots(level);
+    add_sidecar_entry(level);
+    try {
+      write_xdmf(run_.sidecar(), sidecar_entries_);
+    } catch (const InputError& error) {
+      throw environment_failure(error.what());
+    }
+    log(fmt::format("level {} done: {} iterations, {:.1f} s", level, steps_taken(),
+                    statistics_.timings["wall"]));
+  }
+
+  Checkpoint make_checkpoint(LevelProgress progress, int frame, int iterations_in_frame) {
+    statistics_.timings["wall"] = level_seconds();
+    level_start_ = Clock::now();
+    const TriMesh& rest = solver_->level_rest_mesh();
+    Checkpoint c;
+    c.code_version = settings_.code_version;
+    c.parameters = claim_.job.parameters.dump();
+    c.level = solver_->level();
+    c.frame = frame;
+    c.time = frame * scene_.time.step;
+    c.positions = as_positions(solver_->positions());
+    c.rest_positions = rest.vertices;
+    c.triangles = rest.triangles;
+    c.finest_positions = solver_->finest_positions();
+    c.solver.progress = progress;
+    c.solver.previous_positions = as_positions(solver_->previous());
+    c.solver.iterations_in_frame = iterations_in_frame;
+    c.statistics = statistics_;
+    return c;
+  }
+
+  /// Writes a checkpoint, timed; a failure to write is the environment's, not the job's.
+  std::uint64_t write(const fs::path& file, const Checkpoint& c) {
+    const Clock::time_point start = Clock::now();
+    try {
+      test_point("checkpoint_write");
+      const std::uint64_t checksum = write_checkpoint(file, c);
+      statistics_.timings["checkpoint"] += seconds_since(start);
+      since_checkpoint_ = Clock::now();
+      iterations_since_checkpoint_ = 0;
+      return checksum;
+    } catch (const CheckpointError& error) {
+      throw environment_failure(error.what());
+    }
+  }
+
+  void record(db::LevelStatus status, const fs::path& file, std::uint64_t checksum,
+              const std::string& error = {}) {
+    const Clock::time_point start = Clock::now();
+    db::LevelRecord level;
+    level.level = solver_ ? solver_->level() : 0;
+    level.status = status;
+    level.iterations = steps_taken();
+    for (const IterationRecord& it : statistics_.iterations)
+      level.residuals.push_back(it.gradient_norm);
+    level.timings = statistics_.timings;
+    if (!file.empty()) {
+      level.checkpoint_path = fs::absolute(file).lexically_normal().string();
+      level.checkpoint_checksum = checksum_text(checksum);
+    }
+    level.error = error;
+    test_point("record_level");
+    through_store([&] { store_.record_level(claim_.lease, level); });
+    statistics_.timings["database"] += seconds_since(start);
+  }
+
+  std::int64_t steps_taken() const {
+    return std::count_if(statistics_.iterations.begin(), statistics_.iterations.end(),
+                         [](const IterationRecord& it) { return it.step_length > 0.0; });
+  }
+
+  void add_sidecar_entry(int level) {
+    const fs::path file = run_.level_checkpoint(level);
+    if (std::any_of(sidecar_entries_.begin(), sidecar_entries_.end(),
+                    [&](const XdmfEntry& e) { return e.level == level; }))
+      return;
+    try {
+      sidecar_entries_.push_back(xdmf_entry(file.filename().string(), read_checkpoint(file)));
+    } catch (const CheckpointError& error) {
+      log(fmt::format("the sidecar leaves out level {}: {}", level, error.what()));
+    }
+  }
+
+  // ---- endings -------------------------------------------------------------------------------
+
+  RunOutcome fail(db::Outcome outcome, const std::string& message) {
+    try {
+      record(db::LevelStatus::failed, {}, 0, message);
+      through_store([&] { store_.finish(claim_.lease, outcome, message); });
+    } catch (const db::LeaseLostError&) {
+      return RunOutcome::lease_lost;
+    }
+    log(fmt::format("failed: {}", message));
+    return RunOutcome::failed;
+  }
+
+  WorkerEnvironmentError environment_failure(const std::string& what) {
+    try {
+      store_.release(claim_.lease);
+    } catch (const std::exception&) {
+      // The store may share the failing disk; the lease then expires instead.
+    }
+    return WorkerEnvironmentError(fmt::format(
+        "{} (job {} released; fix the output directory or free disk space, then run psq work "
+        "again)",
+        what, claim_.job.id));
+  }
+
+  void log(const std::string& line) const {
+    if (events_.log) events_.log(fmt::format("job {}: {}", claim_.job.id, line));
+  }
+
+  db::JobStore& store_;
+  const SolverFactory& factory_;
+  const ExecutorSettings& settings_;
+  const ExecutorEvents& events_;
+  const std::atomic<bool>& stop_;
+  const db::Claim& claim_;
+  RunDirectory run_;
+  Heartbeat heartbeat_;
+  Scene scene_;
+  std::unique_ptr<LevelSolver> solver_;
+  LevelStatistics statistics_;  ///< of the current level, over all attempts so far
+  std::vector<XdmfEntry> sidecar_entries_;
+  Clock::time_point run_start_ = Clock::now();
+  Clock::time_point level_start_ = Clock::now();  ///< start of the wall time not yet counted
+  Clock::time_point since_checkpoint_ = Clock::now();
+  int iterations_since_checkpoint_ = 0;
+  /// (frame, iterations done) of a frame restored in progress, until its next step.
+  std::optional<std::pair<int, int>> resumed_in_frame_;
+};
+
+}  // namespace
+
+JobExecutor::JobExecutor(db::JobStore& store, fs::path database, fs::path runs_dir,
+                         SolverFactory factory, ExecutorSettings settings, ExecutorEvents events,
+                         const std::atomic<bool>& stop)
+    : store_(store),
+      database_(std::move(database)),
+      runs_dir_(std::move(runs_dir)),
+      factory_(std::move(factory)),
+      settings_(std::move(settings)),
+      events_(std::move(events)),
+      stop_(stop) {}
+
+RunOutcome JobExecutor::run(const db::Claim& claim) {
+  return JobRun(store_, database_, runs_dir_, factory_, settings_, events_, stop_, claim).run();
+}
+
+}  // namespace psq::jobs

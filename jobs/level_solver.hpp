@@ -1,0 +1,64 @@
+#pragma once
+// The step-wise solver a job executor drives: a hierarchy of levels (0 = coarsest), each solved
+// frame by frame, checkpointable between Newton iterations. A direct solve is a hierarchy of
+// one level (jobs/direct_level_solver.hpp); the progressive solver has the same shape.
+
+#include <Eigen/Core>
+#include <functional>
+
+#include "engine/mesh/tri_mesh.hpp"
+#include "engine/solver/solver_stats.hpp"
+
+namespace psq::jobs {
+
+/// One solved frame of a level.
+struct LevelFrame {
+  int level = 0;
+  int frame = 0;  ///< 1-based; frame 0 is the rest state
+  bool converged = false;
+  int iterations = 0;          ///< Newton iterations of the frame, including any before a restore
+  double step_norm = 0.0;      ///< final ‖d‖∞ / Δt
+  double gradient_norm = 0.0;  ///< final ‖∇E‖
+  PhaseTimes times;            ///< of this step() call
+};
+
+class LevelSolver {
+ public:
+  /// Called after every Newton iteration with the frame being solved (1-based). When the record
+  /// took a step (step_length > 0), positions() is the new iterate and previous() its xᵗ.
+  using Progress = std::function<void(int frame, const NewtonIteration&)>;
+
+  virtual ~LevelSolver() = default;
+
+  [[nodiscard]] virtual int level_count() const = 0;
+  /// The level being solved, 0 = coarsest.
+  [[nodiscard]] virtual int level() const = 0;
+  /// Frames of this level solved so far.
+  [[nodiscard]] virtual int frame() const = 0;
+  /// Frames this level solves in all (for progress estimates).
+  [[nodiscard]] virtual int frame_count() const = 0;
+  /// This level has solved all its frames: refine() or, at the finest level, finished.
+  [[nodiscard]] virtual bool level_done() const = 0;
+  /// The finest level is done.
+  [[nodiscard]] virtual bool finished() const = 0;
+  /// Solves the next frame of the current level. Throws NumericalError on a numerical failure.
+  virtual LevelFrame step(const Progress& progress) = 0;
+  /// Moves to the next finer level, initialized from the current one. Requires level_done().
+  virtual void refine() = 0;
+  /// The current level's positions (3n, flat); the current iterate during step().
+  [[nodiscard]] virtual const Eigen::VectorXd& positions() const = 0;
+  /// xᵗ of the frame being (or last) solved.
+  [[nodiscard]] virtual const Eigen::VectorXd& previous() const = 0;
+  /// The rest mesh of the current level.
+  [[nodiscard]] virtual const TriMesh& level_rest_mesh() const = 0;
+  /// The current level's state prolonged to the finest mesh (positions() at the finest level).
+  [[nodiscard]] virtual Positions finest_positions() const = 0;
+  /// Continues from a checkpoint of level `level`. With `iterations_in_frame` = 0, frame
+  /// `frame` is solved and `positions` is its result; otherwise frame `frame` is in progress
+  /// after that many Newton iterations from xᵗ = `previous`, and the next step() continues it
+  /// so that the result equals an uninterrupted run's.
+  virtual void restore(int level, int frame, const Eigen::VectorXd& positions,
+                       const Eigen::VectorXd& previous, int iterations_in_frame) = 0;
+};
+
+}  // namespace psq::jobs

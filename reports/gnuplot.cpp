@@ -1,0 +1,129 @@
+#include "reports/gnuplot.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "engine/core/error.hpp"
+#include "reports/child_process.hpp"
+
+namespace psq::reports {
+namespace {
+
+bool drawable(const PlotSpec& plot, const std::pair<double, double>& point) {
+  const auto [x, y] = point;
+  return std::isfinite(x) && std::isfinite(y) && (!plot.log_x || x > 0) && (!plot.log_y || y > 0);
+}
+
+/// A gnuplot single-quoted string: no escapes are interpreted, a quote is doubled.
+std::string quoted(const std::string& text) {
+  std::string result = "'";
+  for (char c : text) {
+    if (c == '\'')
+      result += "''";
+    else if (c == '\n' || c == '\r')
+      result += ' ';
+    else
+      result += c;
+  }
+  return result + "'";
+}
+
+const char* style_name(PlotSpec::Style style) {
+  switch (style) {
+    case PlotSpec::Style::lines:
+      return "lines lw 1.5";
+    case PlotSpec::Style::points:
+      return "points pt 7 ps 0.8";
+    case PlotSpec::Style::linespoints:
+      return "linespoints lw 1.5 pt 7 ps 0.6";
+  }
+  return "linespoints";
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+bool has_drawable_points(const PlotSpec& plot) {
+  for (const PlotSeries& series : plot.series)
+    for (const auto& point : series.points)
+      if (drawable(plot, point)) return true;
+  return false;
+}
+
+std::string gnuplot_script(const PlotSpec& plot, const std::filesystem::path& output) {
+  std::string script;
+  script += "set terminal svg size 640,400 font 'Sans,11' background rgb 'white' noenhanced\n";
+  script += fmt::format("set output {}\n", quoted(output.string()));
+  script += fmt::format("set title {}\n", quoted(plot.title));
+  script +=
+      fmt::format("set xlabel {}\nset ylabel {}\n", quoted(plot.x_label), quoted(plot.y_label));
+  // The legend goes below the plot, where long labels do not squeeze it; the offsets keep
+  // points off the frame.
+  script += "set grid\nset key below\n";
+  script += "set offsets graph 0.04, graph 0.04, graph 0.04, graph 0.04\n";
+  if (plot.log_x) script += "set logscale x 10\nset format x '%.0e'\n";
+  if (plot.log_y) script += "set logscale y 10\nset format y '%.0e'\n";
+  if (plot.integer_x) script += "set xtics 1\n";
+  std::vector<std::string> clauses;
+  for (std::size_t s = 0; s < plot.series.size(); ++s) {
+    std::string block;
+    for (const auto& point : plot.series[s].points)
+      if (drawable(plot, point))
+        block += fmt::format("{:.17g} {:.17g}\n", point.first, point.second);
+    if (block.empty()) continue;
+    script += fmt::format("$series{} << EOD\n{}EOD\n", s, block);
+    clauses.push_back(fmt::format("$series{} using 1:2 with {} title {}", s, style_name(plot.style),
+                                  quoted(plot.series[s].title)));
+  }
+  script += "plot ";
+  for (std::size_t c = 0; c < clauses.size(); ++c) script += (c ? ", \\\n     " : "") + clauses[c];
+  return script + "\n";
+}
+
+Gnuplot::Gnuplot(std::string program, std::filesystem::path scratch)
+    : program_(std::move(program)), scratch_(std::move(scratch)) {}
+
+std::vector<std::string> Gnuplot::render_svgs(const std::vector<PlotSpec>& plots) {
+  if (plots.empty()) return {};
+  // One process for all plots: starting gnuplot costs more than drawing a plot.
+  const int run = runs_++;
+  const auto image = [&](std::size_t p) { return scratch_ / fmt::format("run{}-{}.svg", run, p); };
+  const std::filesystem::path script = scratch_ / fmt::format("run{}.gp", run);
+  {
+    std::ofstream out(script);
+    for (std::size_t p = 0; p < plots.size(); ++p)
+      out << gnuplot_script(plots[p], image(p)) << "reset\n";
+  }
+  ChildExit exit;
+  try {
+    exit = run_child(program_, {script.string()}, scratch_ / fmt::format("run{}.err", run));
+  } catch (const InputError& e) {
+    throw InputError(
+        fmt::format("{}; the report draws its plots with gnuplot: install it "
+                    "(Debian package gnuplot-nox, see scripts/setup.sh) or name it "
+                    "with --gnuplot PATH",
+                    e.what()));
+  }
+  if (exit.status != 0)
+    throw Error(fmt::format("gnuplot ('{}') failed with status {} on {}: {}", program_, exit.status,
+                            script.string(), exit.errors));
+  std::vector<std::string> svgs;
+  for (std::size_t p = 0; p < plots.size(); ++p) {
+    svgs.push_back(read_text(image(p)));
+    if (svgs.back().find("</svg>") == std::string::npos)
+      throw Error(fmt::format("gnuplot ('{}') did not draw the plot '{}': {}", program_,
+                              plots[p].title, exit.errors));
+  }
+  return svgs;
+}
+
+}  // namespace psq::reports

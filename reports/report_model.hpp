@@ -1,0 +1,89 @@
+#pragma once
+// What a sweep report shows, gathered from the job store and the jobs' checkpoints before any
+// file is written: per job its parameters, state and outputs, per level its convergence,
+// time, error to the finest level and final shape. Every writer (CSV, JSON, Markdown, HTML)
+// reads only this model. docs/reports.md defines each quantity.
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "db/job_records.hpp"
+#include "engine/mesh/tri_mesh.hpp"
+
+namespace psq::db {
+class JobStore;
+}
+
+namespace psq::reports {
+
+/// A level's final shape, read from its checkpoint.
+struct LevelShape {
+  Positions positions;  ///< n×3
+  Triangles triangles;  ///< m×3
+};
+
+/// One hierarchy level of a job.
+struct LevelReport {
+  int level = 0;  ///< 0 = coarsest
+  /// The store's level status ("running", "done", "failed"), or "missing" when the store has
+  /// no record of the level.
+  std::string status;
+  std::int64_t iterations = 0;
+  std::vector<double> residuals;  ///< per Newton iteration, as recorded in the store
+  std::map<std::string, double> timings;
+  std::optional<double> seconds;         ///< level_seconds(timings), if any timing
+  std::optional<double> final_residual;  ///< the last finite residual
+  /// max_i ‖P(x_l)_i − x_L,i‖ / diag(x_L): this level's state prolonged to the finest mesh
+  /// against the finest level's converged state, relative to the latter's bounding box.
+  std::optional<double> error_to_finest;
+  std::string checkpoint;           ///< as recorded in the store; empty if none
+  std::string error;                ///< the level's failure message, if it failed
+  std::optional<LevelShape> shape;  ///< only for levels of finished jobs with a readable checkpoint
+};
+
+/// Scalar results of a finished job, from its finest level's checkpoint.
+struct JobOutputs {
+  std::optional<double> max_displacement;  ///< max_i ‖x_i − X_i‖ (m), finest level
+  std::optional<double> elastic_energy;    ///< solver scalar "elastic_energy" (J), if recorded
+  std::optional<double> total_seconds;     ///< sum of the levels' seconds
+};
+
+/// One job of the sweep.
+struct JobReport {
+  int number = 0;  ///< 1-based position in the sweep: the label used in plots and tables
+  db::Job job;
+  std::map<std::string, nlohmann::json> parameters;  ///< flatten_parameters(job.parameters)
+  std::vector<LevelReport> levels;                   ///< one per level of the job's depth
+  JobOutputs outputs;
+  /// Checkpoints that are missing, damaged or inconsistent, and similar findings; shown in
+  /// the report instead of aborting it.
+  std::vector<std::string> problems;
+
+  bool finished() const { return job.state == db::JobState::done; }
+};
+
+/// Everything a report of one sweep shows.
+struct SweepReport {
+  std::string name;
+  std::string source;  ///< the sweep file
+  std::filesystem::path database;
+  std::map<db::JobState, std::int64_t> counts;
+  std::vector<JobReport> jobs;
+  /// Flattened parameter names whose value differs between jobs, sorted.
+  std::vector<std::string> swept_parameters;
+  /// Every flattened parameter name of any job, sorted: the table columns.
+  std::vector<std::string> parameter_names;
+  int max_depth = 0;  ///< the largest job depth: the number of per-level columns
+};
+
+/// Reads the sweep `sweep` from `store` and every checkpoint its finished jobs recorded.
+/// Relative checkpoint paths are resolved against the store's directory (the workspace),
+/// then against the current directory. A missing, damaged or inconsistent checkpoint becomes
+/// a problem of its job. Throws InputError for an unknown sweep.
+SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep);
+
+}  // namespace psq::reports

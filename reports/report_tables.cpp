@@ -1,0 +1,144 @@
+#include "reports/report_tables.hpp"
+
+#include <fmt/format.h>
+
+#include "reports/parameters.hpp"
+
+namespace psq::reports {
+namespace {
+
+/// Shortest text that reads back to the same double; empty for no value.
+std::string exact_number(std::optional<double> value) {
+  return value ? exact_text(*value) : std::string();
+}
+
+std::string joined(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string text;
+  for (const std::string& part : parts) text += (text.empty() ? "" : separator) + part;
+  return text;
+}
+
+std::string parameter_cell(const JobReport& job, const std::string& name) {
+  const auto found = job.parameters.find(name);
+  return found == job.parameters.end() ? std::string() : cell_text(found->second);
+}
+
+std::string state_of(const JobReport& job) { return std::string(db::to_string(job.job.state)); }
+
+}  // namespace
+
+std::string readable_number(std::optional<double> value) {
+  return value ? fmt::format("{:.4g}", *value) : std::string();
+}
+
+Table results_table(const SweepReport& report) {
+  Table table;
+  table.header = {"number", "id"};
+  table.header.insert(table.header.end(), report.parameter_names.begin(),
+                      report.parameter_names.end());
+  for (const char* column : {"state", "attempts", "failures", "error", "total_seconds",
+                             "max_displacement", "elastic_energy", "problems"})
+    table.header.push_back(column);
+  for (int l = 0; l < report.max_depth; ++l)
+    for (const char* column : {"status", "iterations", "seconds", "residual", "error"})
+      table.header.push_back(fmt::format("level{}.{}", l, column));
+
+  for (const JobReport& job : report.jobs) {
+    std::vector<std::string> row = {std::to_string(job.number), job.job.id};
+    for (const std::string& name : report.parameter_names) row.push_back(parameter_cell(job, name));
+    row.insert(row.end(),
+               {state_of(job), std::to_string(job.job.attempt), std::to_string(job.job.failures),
+                job.job.error, exact_number(job.outputs.total_seconds),
+                exact_number(job.outputs.max_displacement),
+                exact_number(job.outputs.elastic_energy), joined(job.problems, "; ")});
+    for (int l = 0; l < report.max_depth; ++l) {
+      if (l >= static_cast<int>(job.levels.size())) {
+        row.insert(row.end(), 5, std::string());
+        continue;
+      }
+      const LevelReport& level = job.levels[l];
+      row.insert(row.end(),
+                 {level.status, std::to_string(level.iterations), exact_number(level.seconds),
+                  exact_number(level.final_residual), exact_number(level.error_to_finest)});
+    }
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+Table jobs_table(const SweepReport& report) {
+  Table table;
+  table.header = {"#", "id"};
+  table.header.insert(table.header.end(), report.swept_parameters.begin(),
+                      report.swept_parameters.end());
+  for (const char* column :
+       {"state", "time (s)", "max displacement (m)", "elastic energy (J)", "error"})
+    table.header.push_back(column);
+  for (const JobReport& job : report.jobs) {
+    std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
+    for (const std::string& name : report.swept_parameters)
+      row.push_back(parameter_cell(job, name));
+    row.insert(row.end(), {state_of(job), readable_number(job.outputs.total_seconds),
+                           readable_number(job.outputs.max_displacement),
+                           readable_number(job.outputs.elastic_energy), job.job.error});
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+Table levels_table(const SweepReport& report) {
+  Table table;
+  table.header = {"#",        "level",           "status",    "iterations", "final residual",
+                  "time (s)", "error to finest", "checkpoint"};
+  for (const JobReport& job : report.jobs)
+    for (const LevelReport& level : job.levels)
+      table.rows.push_back({std::to_string(job.number), std::to_string(level.level), level.status,
+                            std::to_string(level.iterations), readable_number(level.final_residual),
+                            readable_number(level.seconds), readable_number(level.error_to_finest),
+                            level.checkpoint});
+  return table;
+}
+
+std::string to_csv(const Table& table) {
+  const auto field = [](const std::string& text) {
+    if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
+  };
+  std::string csv;
+  const auto add_line = [&](const std::vector<std::string>& cells) {
+    std::vector<std::string> fields;
+    for (const std::string& cell : cells) fields.push_back(field(cell));
+    csv += joined(fields, ",") + "\r\n";
+  };
+  add_line(table.header);
+  for (const auto& row : table.rows) add_line(row);
+  return csv;
+}
+
+std::string to_markdown(const Table& table) {
+  const auto cell = [](const std::string& text) {
+    std::string escaped;
+    for (char c : text) {
+      if (c == '|')
+        escaped += "\\|";
+      else if (c == '\n' || c == '\r')
+        escaped += ' ';
+      else
+        escaped += c;
+    }
+    return escaped;
+  };
+  const auto line = [&](const std::vector<std::string>& cells) {
+    std::vector<std::string> escaped;
+    for (const std::string& text : cells) escaped.push_back(cell(text));
+    return "| " + joined(escaped, " | ") + " |\n";
+  };
+  std::string markdown = line(table.header);
+  markdown += line(std::vector<std::string>(table.header.size(), "---"));
+  for (const auto& row : table.rows) markdown += line(row);
+  return markdown;
+}
+
+}  // namespace psq::reports

@@ -1,0 +1,41 @@
+#pragma once
+// The report's tables as plain text cells, built once from the model and printed as CSV,
+// Markdown or HTML.
+
+#include <string>
+#include <vector>
+
+#include "reports/report_model.hpp"
+
+namespace psq::reports {
+
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;  ///< each as long as the header
+};
+
+/// results.csv: one row per job — number, id, every flattened parameter, state, attempts,
+/// failures, error, total seconds, max displacement, elastic energy, problems, then per level
+/// l < max depth: level<l>.status, .iterations, .seconds, .residual, .error. Numbers in the
+/// shortest form that reads back exactly; empty cells where there is no value.
+Table results_table(const SweepReport& report);
+
+/// The jobs at a glance: number, short id, swept parameters, state, time, max displacement,
+/// elastic energy, and the failure message. Numbers with 4 significant digits.
+Table jobs_table(const SweepReport& report);
+
+/// One row per job level: number, level, status, iterations, final residual, seconds, error
+/// to the finest level, checkpoint.
+Table levels_table(const SweepReport& report);
+
+/// RFC 4180 CSV: fields with a comma, quote or line break are quoted, quotes doubled; lines
+/// end with CRLF.
+std::string to_csv(const Table& table);
+
+/// A GitHub-flavoured Markdown table (pipes escaped, line breaks as spaces).
+std::string to_markdown(const Table& table);
+
+/// "1.235e-05"-style text with 4 significant digits; empty for no value.
+std::string readable_number(std::optional<double> value);
+
+}  // namespace psq::reports

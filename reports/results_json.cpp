@@ -1,0 +1,62 @@
+#include "reports/results_json.hpp"
+
+#include <cmath>
+
+namespace psq::reports {
+namespace {
+
+nlohmann::json number_or_null(std::optional<double> value) {
+  return value && std::isfinite(*value) ? nlohmann::json(*value) : nlohmann::json();
+}
+
+nlohmann::json level_json(const LevelReport& level) {
+  nlohmann::json residuals = nlohmann::json::array();
+  for (double residual : level.residuals) residuals.push_back(number_or_null(residual));
+  return {{"level", level.level},
+          {"status", level.status},
+          {"iterations", level.iterations},
+          {"seconds", number_or_null(level.seconds)},
+          {"timings", level.timings},
+          {"final_residual", number_or_null(level.final_residual)},
+          {"error_to_finest", number_or_null(level.error_to_finest)},
+          {"checkpoint", level.checkpoint},
+          {"error", level.error},
+          {"residuals", residuals}};
+}
+
+nlohmann::json job_json(const JobReport& job) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (const LevelReport& level : job.levels) levels.push_back(level_json(level));
+  return {{"number", job.number},
+          {"id", job.job.id},
+          {"parameters", job.job.parameters},
+          {"flat_parameters", job.parameters},
+          {"state", db::to_string(job.job.state)},
+          {"attempts", job.job.attempt},
+          {"failures", job.job.failures},
+          {"error", job.job.error},
+          {"outputs",
+           {{"total_seconds", number_or_null(job.outputs.total_seconds)},
+            {"max_displacement", number_or_null(job.outputs.max_displacement)},
+            {"elastic_energy", number_or_null(job.outputs.elastic_energy)}}},
+          {"problems", job.problems},
+          {"levels", levels}};
+}
+
+}  // namespace
+
+nlohmann::json results_json(const SweepReport& report) {
+  nlohmann::json counts = nlohmann::json::object();
+  for (const auto& [state, count] : report.counts)
+    counts[std::string(db::to_string(state))] = count;
+  nlohmann::json jobs = nlohmann::json::array();
+  for (const JobReport& job : report.jobs) jobs.push_back(job_json(job));
+  return {{"sweep", report.name},
+          {"source", report.source},
+          {"database", report.database.string()},
+          {"counts", counts},
+          {"swept_parameters", report.swept_parameters},
+          {"jobs", jobs}};
+}
+
+}  // namespace psq::reports

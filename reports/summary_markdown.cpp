@@ -1,0 +1,26 @@
+#include "reports/summary_markdown.hpp"
+
+#include <fmt/format.h>
+
+#include "reports/report_tables.hpp"
+
+namespace psq::reports {
+
+std::string summary_markdown(const SweepReport& report) {
+  std::string text = fmt::format("# Sweep {}\n\nSweep file: `{}`  \nJob store: `{}`\n\n",
+                                 report.name, report.source, report.database.string());
+  Table counts{{"state", "jobs"}, {}};
+  for (const auto& [state, count] : report.counts)
+    counts.rows.push_back({std::string(db::to_string(state)), std::to_string(count)});
+  text += to_markdown(counts);
+  text += "\n## Jobs\n\n" + to_markdown(jobs_table(report));
+  text += "\n## Levels\n\n" + to_markdown(levels_table(report));
+  std::string problems;
+  for (const JobReport& job : report.jobs)
+    for (const std::string& problem : job.problems)
+      problems += fmt::format("- job #{} ({}): {}\n", job.number, job.job.id, problem);
+  if (!problems.empty()) text += "\n## Problems\n\n" + problems;
+  return text;
+}
+
+}  // namespace psq::reports

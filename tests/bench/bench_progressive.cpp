@@ -1,0 +1,146 @@
+// Benchmark (prints, never fails on a slow machine): progressive vs direct simulation of the
+// drape, twist and cylinder scenes at ~20k–50k fine vertices. Per scene: the time of the direct
+// fine solve, of each progressive level and in total, and the errors (max vertex distance /
+// bounding-box diagonal) to the settled direct fine answer of: the progressive finest answer,
+// the level-0 preview prolonged to the finest mesh, and a direct simulation of the level-0 mesh
+// (its own elastics) prolonged the same way. Targets (issue 4): level-0 preview ≥ 50× faster
+// than the direct fine solve; progressive total faster than the direct fine solve.
+//
+// Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
+//                          [--scenes drape,twist,cylinder_compress]
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include "engine/progressive/progressive_simulation.hpp"
+#include "engine/scene/scene_reader.hpp"
+#include "progressive/reference_runs.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
+  return out;
+}
+
+/// The library scene with its mesh's edge length set for about `vertices` vertices
+/// (near-equilateral triangles: 2/(√3 e²) vertices per unit area).
+psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
+  psq::Scene scene = psq::read_scene(PSQ_SOURCE_DIR "/jobs/scenes/" + name + ".toml");
+  psq::MeshSource& mesh = scene.shells.at(0).mesh;
+  const double area = mesh.kind == psq::MeshSource::Kind::Cylinder
+                          ? 2 * M_PI * mesh.cylinder.radius * mesh.cylinder.height
+                          : mesh.sheet.width * mesh.sheet.height;
+  const double edge = std::sqrt(area * 2 / (std::sqrt(3.0) * vertices));
+  mesh.sheet.edge_length = mesh.cylinder.edge_length = edge;
+  scene.time.step *= double(scene.time.frames) / frames;
+  scene.time.frames = frames;
+  return scene;
+}
+
+void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings) {
+  auto start = Clock::now();
+  psq::ProgressiveSimulation sim(scene, settings);
+  const double hierarchy_seconds = seconds_since(start);
+  std::cout << fmt::format("{}: {} fine vertices, {} levels (hierarchy {:.2f} s):", scene.name,
+                           sim.finest_system().rest_mesh().vertex_count(), sim.level_count(),
+                           hierarchy_seconds);
+  for (const psq::MeshHierarchy& h : sim.hierarchies())
+    for (const psq::HierarchyLevel& level : h.levels) std::cout << " " << level.rest.vertex_count();
+  std::cout << "\n";
+
+  Eigen::VectorXd preview;
+  double preview_seconds = 0.0, total_seconds = 0.0;
+  while (true) {
+    start = Clock::now();
+    int steps = 0, iterations = 0;
+    while (!sim.level_done()) {
+      iterations += sim.step().frame.newton.iterations;
+      ++steps;
+    }
+    const double level_seconds = seconds_since(start);
+    total_seconds += level_seconds;
+    std::cout << fmt::format("  level {} ({} vertices): {} steps, {} iterations, {:.2f} s{}\n",
+                             sim.level(), sim.level_rest_mesh().vertex_count(), steps, iterations,
+                             level_seconds, sim.level_converged() ? "" : " (NOT converged)");
+    if (sim.level() == 0) {
+      preview = sim.finest_positions();
+      preview_seconds = level_seconds;
+    }
+    if (sim.finished()) break;
+    sim.refine();
+  }
+
+  const psq::ShellSystem& fine = sim.finest_system();
+  start = Clock::now();
+  const psq::test::DirectRun direct = psq::test::settled_direct_run(fine, sim.finest_tolerance());
+  const double direct_seconds = seconds_since(start);
+
+  const psq::MeshHierarchy& h = sim.hierarchies().at(0);
+  const psq::ShellSystem coarse(scene, {{h.levels[0].rest, h.levels[0].pin_group}});
+  start = Clock::now();
+  const psq::test::DirectRun direct_coarse =
+      psq::test::settled_direct_run(coarse, sim.finest_tolerance());
+  const double coarse_seconds = seconds_since(start);
+  const psq::ShellProlongation to_finest(h.levels[0].rest, h.levels[0].finest,
+                                         fine.rest_mesh().vertices);
+  const Eigen::VectorXd coarse_prolonged =
+      psq::flat(to_finest.apply(psq::as_positions(direct_coarse.positions)));
+
+  const double diagonal = psq::bounding_box_diagonal(fine.rest_mesh().vertices);
+  const auto error = [&](const Eigen::VectorXd& x) {
+    return psq::test::max_vertex_distance(x, direct.positions) / diagonal;
+  };
+  std::cout << fmt::format(
+      "  direct fine: {} iterations, {:.2f} s{}; direct coarse: {:.2f} s\n"
+      "  progressive: preview {:.2f} s ({:.1f}× faster than direct fine), total {:.2f} s "
+      "({:.2f}× the direct fine time)\n"
+      "  error / bbox diagonal: progressive finest {:.2e}, level-0 preview {:.2e}, "
+      "direct coarse {:.2e}\n",
+      direct.newton_iterations, direct_seconds, direct.settled ? "" : " (NOT settled)",
+      coarse_seconds, preview_seconds, direct_seconds / preview_seconds, total_seconds,
+      total_seconds / direct_seconds, error(sim.positions()), error(preview),
+      error(coarse_prolonged));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int vertices = 20000, levels = 3, frames = 10;
+  std::string gradient = "held";
+  std::vector<std::string> scenes{"drape", "twist", "cylinder_compress"};
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string arg = argv[i], value = argv[i + 1];
+    if (arg == "--vertices") vertices = std::stoi(value);
+    else if (arg == "--levels") levels = std::stoi(value);
+    else if (arg == "--frames") frames = std::stoi(value);
+    else if (arg == "--gradient") gradient = value;
+    else if (arg == "--scenes") scenes = split(value);
+    else {
+      std::cerr << "unknown option " << arg << "\n";
+      return 1;
+    }
+  }
+  std::cout << fmt::format("bench_progressive: ~{} fine vertices, {} levels, {} frames, {} "
+                           "gradient\n", vertices, levels, frames, gradient);
+  for (const std::string& name : scenes) {
+    const psq::Scene scene = sized_scene(name, vertices, frames);
+    psq::ProgressiveSettings settings = psq::ProgressiveSettings::from_scene(scene);
+    settings.schedule.levels = levels;
+    settings.gradient =
+        gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
+    run_scene(scene, settings);
+  }
+  return 0;
+}

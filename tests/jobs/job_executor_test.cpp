@@ -1,0 +1,296 @@
+// The job executor against a scripted LevelSolver: levels recorded with their checkpoints,
+// stop and resume (from the latest snapshot, a damaged one, or nothing), failures, lost leases
+// and unwritable outputs. The real solver and real kills are tested in tests/runner.
+
+#include "jobs/job_executor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <thread>
+
+#include "db/job_store.hpp"
+#include "engine/io/checkpoint.hpp"
+#include "jobs/run_directory.hpp"
+#include "jobs/sweep_file.hpp"
+#include "support/test_paths.hpp"
+
+namespace psq {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A solver whose every frame takes a fixed number of "Newton" iterations, each a contraction
+/// x ← x/2 + (frame + level)·1; its results depend on every iteration taken exactly once.
+class ScriptedSolver final : public jobs::LevelSolver {
+ public:
+  ScriptedSolver(int levels, int frames, int iterations)
+      : levels_(levels), frames_(frames), iterations_(iterations) {
+    rest_.vertices = Positions{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    rest_.triangles = Triangles{{0, 1, 2}};
+    x_ = flat(rest_.vertices);
+    previous_ = x_;
+  }
+
+  int level_count() const override { return levels_; }
+  int level() const override { return level_; }
+  int frame() const override { return frame_; }
+  int frame_count() const override { return frames_; }
+  bool level_done() const override { return frame_ == frames_; }
+  bool finished() const override { return level_done() && level_ == levels_ - 1; }
+
+  jobs::LevelFrame step(const Progress& progress) override {
+    const int frame = frame_ + 1;
+    const int first = std::exchange(resumed_iterations_, 0);
+    if (first == 0) previous_ = x_;
+    for (int k = first; k < iterations_; ++k) {
+      x_ = 0.5 * x_ + Eigen::VectorXd::Constant(x_.size(), frame + level_);
+      NewtonIteration it;
+      it.iteration = k;
+      it.step_length = 1.0;
+      it.gradient_norm = x_.norm();
+      progress(frame, it);
+    }
+    NewtonIteration check;
+    check.iteration = iterations_;
+    progress(frame, check);
+    frame_ = frame;
+    jobs::LevelFrame record;
+    record.level = level_;
+    record.frame = frame;
+    record.converged = frame != fail_at_frame;
+    record.iterations = iterations_;
+    return record;
+  }
+  void refine() override {
+    ++level_;
+    frame_ = 0;
+  }
+  const Eigen::VectorXd& positions() const override { return x_; }
+  const Eigen::VectorXd& previous() const override { return previous_; }
+  const TriMesh& level_rest_mesh() const override { return rest_; }
+  Positions finest_positions() const override { return as_positions(x_); }
+  void restore(int level, int frame, const Eigen::VectorXd& positions,
+               const Eigen::VectorXd& previous, int iterations_in_frame) override {
+    level_ = level;
+    x_ = positions;
+    previous_ = previous;
+    frame_ = iterations_in_frame > 0 ? frame - 1 : frame;
+    resumed_iterations_ = iterations_in_frame;
+  }
+
+  int fail_at_frame = -1;
+
+ private:
+  int levels_, frames_, iterations_;
+  int level_ = 0, frame_ = 0, resumed_iterations_ = 0;
+  TriMesh rest_;
+  Eigen::VectorXd x_, previous_;
+};
+
+constexpr int kFrames = 4;
+constexpr int kIterations = 5;
+
+/// A store with one job of depth 2 on the cantilever scene, and its runs directory.
+class Workspace {
+ public:
+  Workspace() : dir_(test::fresh_temp_dir("job_executor")) {
+    fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir_ / "scene.toml");
+    test::write_file(dir_ / "sweep.toml", "name = \"s\"\nscene = \"scene.toml\"\ndepth = 2\n");
+    const jobs::Sweep sweep = jobs::read_sweep(dir_ / "sweep.toml");
+    db::JobStore(dir_ / "psq.db").add_sweep("s", "sweep.toml", jobs::new_jobs(sweep));
+    job_id_ = sweep.jobs.front().id;
+  }
+
+  /// Claims the job and runs it; `on_iteration` sees every iteration (its number overall).
+  jobs::RunOutcome run(const std::function<void(int)>& on_iteration = {},
+                       const fs::path& runs = {}) {
+    db::JobStore store(dir_ / "psq.db");
+    const auto claim = store.claim_next({"w", "host", "test"}, lease_seconds);
+    EXPECT_TRUE(claim);
+    if (!claim) return jobs::RunOutcome::failed;
+    jobs::ExecutorEvents events;
+    events.log = [this](const std::string& line) { log += line + "\n"; };
+    events.progress = [&](const jobs::JobProgress&) {
+      if (on_iteration) on_iteration(++iterations_seen_);
+    };
+    jobs::JobExecutor executor(
+        store, dir_ / "psq.db", runs.empty() ? dir_ / "runs" : runs,
+        [this](const Scene&, int depth) {
+          auto solver = std::make_unique<ScriptedSolver>(depth, kFrames, kIterations);
+          solver->fail_at_frame = fail_at_frame;
+          return solver;
+        },
+        {.snapshot_iterations = 2, .snapshot_seconds = 1e9, .code_version = "test"}, events, stop);
+    return executor.run(*claim);
+  }
+
+  db::JobResult result() const {
+    return db::JobStore(dir_ / "psq.db").results(db::JobSelection::job(job_id_)).front();
+  }
+  jobs::RunDirectory run_dir() const { return jobs::RunDirectory(dir_ / "runs" / job_id_); }
+  Checkpoint final_checkpoint() const { return read_checkpoint(run_dir().level_checkpoint(1)); }
+  const fs::path& dir() const { return dir_; }
+  const std::string& job_id() const { return job_id_; }
+
+  std::atomic<bool> stop{false};
+  std::string log;
+  int fail_at_frame = -1;
+  double lease_seconds = 30.0;
+
+ private:
+  fs::path dir_;
+  std::string job_id_;
+  int iterations_seen_ = 0;
+};
+
+/// The final state and iteration history of an uninterrupted run of the job.
+const Checkpoint& reference() {
+  static const Checkpoint checkpoint = [] {
+    Workspace fresh;
+    EXPECT_EQ(fresh.run(), jobs::RunOutcome::done);
+    return fresh.final_checkpoint();
+  }();
+  return checkpoint;
+}
+
+void expect_same_as_reference(const Checkpoint& c) {
+  EXPECT_EQ(c.positions, reference().positions);
+  ASSERT_EQ(c.statistics.iterations.size(), reference().statistics.iterations.size());
+  for (std::size_t k = 0; k < c.statistics.iterations.size(); ++k) {
+    EXPECT_EQ(c.statistics.iterations[k].frame, reference().statistics.iterations[k].frame);
+    EXPECT_EQ(c.statistics.iterations[k].iteration, reference().statistics.iterations[k].iteration);
+    EXPECT_EQ(c.statistics.iterations[k].gradient_norm,
+              reference().statistics.iterations[k].gradient_norm);
+  }
+}
+
+class Executor : public ::testing::Test, public Workspace {};
+
+TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  const db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::done);
+  ASSERT_EQ(r.levels.size(), 2u);
+  for (const db::LevelRecord& level : r.levels) {
+    EXPECT_EQ(level.status, db::LevelStatus::done);
+    EXPECT_EQ(level.iterations, kFrames * kIterations);
+    EXPECT_EQ(level.residuals.size(), std::size_t(kFrames * (kIterations + 1)));
+    const fs::path file = run_dir().level_checkpoint(level.level);
+    EXPECT_EQ(fs::path(level.checkpoint_path), fs::absolute(file));
+    // The recorded checksum is the file's: read_checkpoint verifies it.
+    const auto checksum = jobs::parse_checksum(level.checkpoint_checksum);
+    ASSERT_TRUE(checksum);
+    EXPECT_EQ(read_checkpoint(file, *checksum).level, level.level);
+    EXPECT_GT(level.timings.at("checkpoint"), 0.0);
+    EXPECT_GT(level.timings.at("database"), 0.0);
+    EXPECT_FALSE(fs::exists(run_dir().snapshot(level.level)));
+    EXPECT_FALSE(fs::exists(run_dir().previous_snapshot(level.level)));
+  }
+  // Every iteration of every frame of both levels applied once, in order: x ← x/2 + frame +
+  // level, from the rest position 0 of vertex 0.
+  double expected = 0.0;
+  for (int level = 0; level < 2; ++level)
+    for (int frame = 1; frame <= kFrames; ++frame)
+      for (int k = 0; k < kIterations; ++k) expected = 0.5 * expected + frame + level;
+  const Checkpoint c = final_checkpoint();
+  EXPECT_EQ(c.positions(0, 0), expected);
+  std::ifstream sidecar(run_dir().sidecar());
+  const std::string xml{std::istreambuf_iterator<char>(sidecar), {}};
+  EXPECT_NE(xml.find("level_0.h5:/mesh/positions"), std::string::npos);
+  EXPECT_NE(xml.find("level_1.h5:/mesh/positions"), std::string::npos);
+}
+
+TEST_F(Executor, StopWritesASnapshotReleasesAndResumesToTheSameResult) {
+  // 27 progress events in (6 per frame: 5 steps and the converged check): level 1, frame 1,
+  // after its third step.
+  const auto stop_after = [this](int n) {
+    if (n == 27) stop = true;
+  };
+  ASSERT_EQ(run(stop_after), jobs::RunOutcome::interrupted);
+  db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::queued);
+  EXPECT_EQ(r.job.failures, 0);
+  ASSERT_EQ(r.levels.size(), 2u);
+  EXPECT_EQ(r.levels[1].status, db::LevelStatus::running);
+  const Checkpoint snapshot = read_checkpoint(run_dir().snapshot(1));
+  EXPECT_EQ(snapshot.solver.progress, LevelProgress::inside_frame);
+  EXPECT_EQ(snapshot.frame, 1);
+  EXPECT_EQ(snapshot.solver.iterations_in_frame, 3);
+
+  stop = false;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  EXPECT_NE(log.find("resuming level 1 frame 1 from level_1.snapshot.h5"), std::string::npos)
+      << log;
+  EXPECT_EQ(result().job.state, db::JobState::done);
+  expect_same_as_reference(final_checkpoint());
+}
+
+TEST_F(Executor, ADamagedSnapshotFallsBackToThePreviousOne) {
+  ASSERT_EQ(run([this](int n) { stop = n == 9; }), jobs::RunOutcome::interrupted);
+  ASSERT_TRUE(fs::exists(run_dir().previous_snapshot(0)));
+  // A torn file: half of the latest snapshot, plus a temporary a killed write left behind.
+  fs::resize_file(run_dir().snapshot(0), fs::file_size(run_dir().snapshot(0)) / 2);
+  test::write_file(run_dir().dir() / ".level_0.snapshot.h5.tmp999", "partial");
+  stop = false;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  EXPECT_NE(log.find("resuming level 0 frame 2 from level_0.snapshot.prev.h5"), std::string::npos)
+      << log;
+  EXPECT_FALSE(fs::exists(run_dir().dir() / ".level_0.snapshot.h5.tmp999"));
+  expect_same_as_reference(final_checkpoint());
+}
+
+TEST_F(Executor, ASnapshotThatDiffersFromTheStoreRecordIsNotTrusted) {
+  ASSERT_EQ(run([this](int n) { stop = n == 9; }), jobs::RunOutcome::interrupted);
+  // A valid checkpoint, but not the file the store recorded (e.g. written by a dead attempt
+  // after the last record): the previous snapshot is used instead.
+  Checkpoint other = read_checkpoint(run_dir().snapshot(0));
+  other.positions(0, 0) += 1.0;
+  write_checkpoint(run_dir().snapshot(0), other);
+  stop = false;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  EXPECT_NE(log.find("level_0.snapshot.prev.h5"), std::string::npos) << log;
+  expect_same_as_reference(final_checkpoint());
+}
+
+TEST_F(Executor, WithNoValidCheckpointTheJobStartsOver) {
+  ASSERT_EQ(run([this](int n) { stop = n == 9; }), jobs::RunOutcome::interrupted);
+  for (const fs::path& file : {run_dir().snapshot(0), run_dir().previous_snapshot(0)})
+    test::write_file(file, "not a checkpoint");
+  stop = false;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  EXPECT_EQ(log.find("resuming"), std::string::npos) << log;
+  expect_same_as_reference(final_checkpoint());
+}
+
+TEST_F(Executor, AFrameThatDoesNotConvergeFailsTheJobForGood) {
+  fail_at_frame = 3;
+  ASSERT_EQ(run(), jobs::RunOutcome::failed);
+  const db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::failed);
+  EXPECT_NE(r.job.error.find("level 0 frame 3 did not converge"), std::string::npos) << r.job.error;
+  ASSERT_EQ(r.levels.size(), 1u);
+  EXPECT_EQ(r.levels[0].status, db::LevelStatus::failed);
+}
+
+TEST_F(Executor, AnUnwritableRunsDirectoryReleasesTheJobAndStopsTheWorker) {
+  test::write_file(dir() / "runs_file", "a file where the runs directory should be");
+  EXPECT_THROW(run({}, dir() / "runs_file"), jobs::WorkerEnvironmentError);
+  const db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::queued);
+  EXPECT_EQ(r.job.failures, 0);
+}
+
+TEST_F(Executor, ACancelledJobStopsAtItsNextHeartbeat) {
+  lease_seconds = 0.3;
+  const auto cancel_then_wait = [this](int n) {
+    if (n != 3) return;
+    db::JobStore(dir() / "psq.db").cancel(db::JobSelection::job(job_id()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));  // > 3 heartbeat periods
+  };
+  EXPECT_EQ(run(cancel_then_wait), jobs::RunOutcome::lease_lost);
+  EXPECT_EQ(result().job.state, db::JobState::cancelled);
+}
+
+}  // namespace
+}  // namespace psq

@@ -1,0 +1,193 @@
+// `psq work` end to end: a sweep run by worker processes, several `psq work` processes on one
+// store (each job run exactly once), the XDMF sidecar of a real job against its HDF5 file, and
+// bad input and a hostile environment (clear error, non-zero exit, a consistent store).
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "db/job_store.hpp"
+#include "engine/io/checkpoint.hpp"
+#include "io/xdmf_validator.hpp"
+#include "jobs/psq_child.hpp"
+#include "support/run_process.hpp"
+#include "support/test_paths.hpp"
+
+namespace psq {
+namespace {
+
+namespace fs = std::filesystem;
+
+class WorkCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_temp_dir("work_command");
+    fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir_ / "scene.toml");
+    db_ = dir_ / ".psq" / "psq.db";
+  }
+  /// Adds a sweep over `grid` (TOML lines of the [grid] table); returns the exit code.
+  int add_sweep(const std::string& grid, const std::string& name = "w") {
+    const fs::path file = test::write_file(
+        dir_ / (name + ".toml"),
+        fmt::format("name = \"{}\"\nscene = \"scene.toml\"\n[grid]\n{}", name, grid));
+    const auto result = psq({"sweep", "add", file.string()});
+    add_errors_ = result.errors;
+    return result.exit_code;
+  }
+  test::ProcessResult psq(std::vector<std::string> arguments) {
+    arguments.insert(arguments.end(), {"--db", db_.string()});
+    return test::run_psq(arguments);
+  }
+  std::vector<db::JobResult> results() {
+    return db::JobStore(db_).results(db::JobSelection::all());
+  }
+  /// The store opens, passes SQLite's integrity check, and every job's state agrees with its
+  /// lease fields (the schema enforces the rest).
+  void expect_store_consistent() {
+    db::JobStore store(db_);
+    EXPECT_TRUE(store.integrity_problems().empty());
+    for (const db::JobResult& r : store.results(db::JobSelection::all()))
+      EXPECT_EQ(r.job.lease_owner.empty(), r.job.state != db::JobState::running) << r.job.id;
+  }
+
+  fs::path dir_, db_;
+  std::string add_errors_;
+};
+
+TEST_F(WorkCommand, WorkerProcessesRunASweepAndRecordEveryJob) {
+  ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [8e-4, 1e-3, 2e-3]\n"), 0);
+  const auto work = psq({"work", "--workers", "2"});
+  EXPECT_EQ(work.exit_code, 0) << work.errors;
+  EXPECT_NE(work.errors.find("2 worker processes"), std::string::npos) << work.errors;
+  EXPECT_NE(work.errors.find("level 0 done"), std::string::npos) << work.errors;
+  for (const db::JobResult& r : results()) {
+    EXPECT_EQ(r.job.state, db::JobState::done);
+    ASSERT_EQ(r.levels.size(), 1u);
+    EXPECT_EQ(r.levels[0].status, db::LevelStatus::done);
+    EXPECT_GT(r.levels[0].iterations, 0);
+    // The cantilever bends down under its tip load, thinner strips more.
+    const Checkpoint c = read_checkpoint(r.levels[0].checkpoint_path);
+    EXPECT_LT(c.positions.col(2).minCoeff(), -1e-5);
+    EXPECT_EQ(c.frame, 10);
+  }
+  expect_store_consistent();
+  // Nothing left: a second run has nothing to do.
+  const auto again = psq({"work", "--workers", "1"});
+  EXPECT_EQ(again.exit_code, 0);
+  EXPECT_NE(again.errors.find("0 done, 0 failed"), std::string::npos) << again.errors;
+}
+
+TEST_F(WorkCommand, TheSidecarOfARealJobMatchesItsHdf5File) {
+  ASSERT_EQ(add_sweep("\"time.frames\" = [3]\n"), 0);
+  ASSERT_EQ(psq({"work", "--workers", "1"}).exit_code, 0);
+  const db::JobResult r = results().front();
+  const fs::path sidecar = dir_ / ".psq" / "runs" / r.job.id / "job.xdmf";
+  const test::SidecarSummary summary = test::validate_sidecar(sidecar);
+  EXPECT_TRUE(summary.problems.empty()) << summary.problems.front();
+  EXPECT_EQ(summary.uniform_grids, 1);
+  EXPECT_GE(summary.hdf_items, 3);  // topology, geometry, rest positions
+}
+
+TEST_F(WorkCommand, SeveralWorkCommandsOnOneStoreRunEachJobExactlyOnce) {
+  ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [6e-4, 7e-4, 8e-4, 9e-4, 1e-3, "
+                      "1.2e-3]\n\"time.frames\" = [4]\n"),
+            0);
+  std::vector<std::unique_ptr<test::PsqChild>> workers;
+  for (int k = 0; k < 3; ++k) {
+    const fs::path log = dir_ / fmt::format("worker{}", k);
+    fs::create_directories(log);
+    workers.push_back(std::make_unique<test::PsqChild>(
+        PSQ_EXECUTABLE,
+        std::vector<std::string>{"work", "--db", db_.string(), "--workers", k == 2 ? "2" : "1"},
+        log));
+  }
+  for (auto& worker : workers) EXPECT_EQ(worker->wait(), 0) << worker->errors();
+  const std::vector<db::JobResult> all = results();
+  ASSERT_EQ(all.size(), 6u);
+  for (const db::JobResult& r : all) {
+    EXPECT_EQ(r.job.state, db::JobState::done);
+    EXPECT_EQ(r.job.attempt, 1) << "job " << r.job.id << " was claimed more than once";
+    ASSERT_EQ(r.levels.size(), 1u);
+    EXPECT_EQ(r.levels[0].attempt, 1);
+  }
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, BadSweepsAreRefusedAndAddNothing) {
+  ASSERT_EQ(add_sweep("\"time.frames\" = [3]\n", "good"), 0);
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"\"shell.strip.material.thickness\" = [-1e-3]\n", "must be positive"},
+      {"\"shell.strip.material.poisson_ratio\" = [0.5]\n", "poisson_ratio"},
+      {"\"depth\" = [0]\n", "depth"},
+      {"\"shell.strip.material.thicknes\" = [1e-3]\n", "thickness"},  // suggested
+      {"\"time.frames\" = [3\n", "bad.toml"},                         // TOML syntax
+  };
+  for (const auto& [grid, expected] : bad) {
+    SCOPED_TRACE(grid);
+    EXPECT_EQ(add_sweep(grid, "bad"), 1);
+    EXPECT_NE(add_errors_.find(expected), std::string::npos) << add_errors_;
+  }
+  test::write_file(dir_ / "broken_scene.toml", "name = \"x\"\n[time]\nstep = -1\n");
+  test::write_file(dir_ / "bad.toml", "name = \"bad\"\nscene = \"broken_scene.toml\"\n");
+  const auto broken = psq({"sweep", "add", (dir_ / "bad.toml").string()});
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_NE(broken.errors.find("broken_scene.toml:3"), std::string::npos) << broken.errors;
+  EXPECT_EQ(results().size(), 1u);
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, AJobWhoseSceneChangedFailsForGoodWithAClearMessage) {
+  ASSERT_EQ(add_sweep("\"time.frames\" = [3]\n"), 0);
+  test::write_file(dir_ / "scene.toml", "# edited\n" + test::read_text(dir_ / "scene.toml"));
+  const auto work = psq({"work", "--workers", "1"});
+  EXPECT_EQ(work.exit_code, 5);
+  const db::JobResult r = results().front();
+  EXPECT_EQ(r.job.state, db::JobState::failed);
+  EXPECT_NE(r.job.error.find("changed since the sweep was added"), std::string::npos)
+      << r.job.error;
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, AnUnwritableOutputDirectoryStopsTheWorkerAndKeepsTheJobQueued) {
+  ASSERT_EQ(add_sweep("\"time.frames\" = [3]\n"), 0);
+  test::write_file(dir_ / ".psq" / "runs", "a file where the runs directory should be");
+  const auto work = psq({"work", "--workers", "1"});
+  EXPECT_EQ(work.exit_code, 1);
+  EXPECT_NE(work.errors.find("cannot create the job's output directory"), std::string::npos)
+      << work.errors;
+  EXPECT_EQ(results().front().job.state, db::JobState::queued);
+  EXPECT_EQ(results().front().job.failures, 0);
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, AFullDiskStopsTheWorkerCleanlyAndTheWorkResumesLater) {
+  // A finer strip (729 vertices): its checkpoints (~100 kB) exceed the limit, while the store's
+  // files (the -shm index takes 32 kB) stay below it.
+  std::string scene = test::read_text(dir_ / "scene.toml");
+  scene.replace(scene.find("edge_length = 0.005"), 19, "edge_length = 0.0025");
+  test::write_file(dir_ / "scene.toml", scene);
+  ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [8e-4, 1e-3]\n"), 0);
+  test::ChildOptions small_disk;
+  small_disk.file_size_limit = 64 * 1024;
+  test::PsqChild child(PSQ_EXECUTABLE, {"work", "--db", db_.string(), "--workers", "1"}, dir_,
+                       small_disk);
+  EXPECT_EQ(child.wait(), 1) << child.errors();
+  EXPECT_NE(child.errors().find("File too large"), std::string::npos) << child.errors();
+  EXPECT_NE(child.errors().find("released"), std::string::npos) << child.errors();
+  expect_store_consistent();
+  EXPECT_EQ(results().front().job.state, db::JobState::queued);
+  const auto resumed = psq({"resume", "w", "--workers", "1"});
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.errors;
+  for (const db::JobResult& r : results()) EXPECT_EQ(r.job.state, db::JobState::done);
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, WithoutAStoreItSaysHowToMakeOne) {
+  const auto work = psq({"work"});
+  EXPECT_EQ(work.exit_code, 1);
+  EXPECT_NE(work.errors.find("psq sweep add"), std::string::npos) << work.errors;
+}
+
+}  // namespace
+}  // namespace psq

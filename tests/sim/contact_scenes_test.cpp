@@ -1,0 +1,116 @@
+// The contact scenes of jobs/scenes, simulated at a coarse CI size (larger edges, fewer frames):
+// every stored frame passes the exact intersection check, contact actually happens, and the
+// skips are counted on frames without anything within reach.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <gtest/gtest.h>
+
+#include "engine/contact/intersection_check.hpp"
+#include "engine/scene/scene_reader.hpp"
+#include "engine/sim/quasistatic.hpp"
+#include "support/test_paths.hpp"
+
+namespace psq {
+namespace {
+
+Scene library_scene(const std::string& name) {
+  return read_scene(test::source_dir() / "jobs" / "scenes" / (name + ".toml"));
+}
+
+/// Sets a generated mesh's target edge length (file meshes are left as they are).
+void set_edge_length(MeshSource& mesh, double edge) {
+  mesh.sheet.edge_length = mesh.cylinder.edge_length = mesh.sphere.edge_length = edge;
+}
+
+/// The outcome of simulating a scene frame by frame.
+struct SceneRun {
+  std::vector<FrameRecord> frames;
+  std::vector<std::string> intersecting_frames;  ///< "frame k: <listing>"
+};
+
+SceneRun simulate(const Scene& scene) {
+  QuasistaticSimulation sim(scene);
+  const Triangles& triangles = sim.system().rest_mesh().triangles;
+  SceneRun run;
+  while (sim.frame() < sim.frame_count()) {
+    run.frames.push_back(sim.step());
+    const IntersectionReport report = find_intersections(as_positions(sim.positions()), triangles);
+    if (!report.clean())
+      run.intersecting_frames.push_back(
+          fmt::format("frame {}: {}", sim.frame(), list_intersections(report, {})));
+  }
+  return run;
+}
+
+long most_active_pairs(const SceneRun& run) {
+  long most = 0;
+  for (const FrameRecord& f : run.frames) most = std::max(most, f.contact.max_active_pairs);
+  return most;
+}
+
+void expect_converged(const SceneRun& run) {
+  for (const FrameRecord& f : run.frames) EXPECT_TRUE(f.newton.converged) << "frame " << f.frame;
+}
+
+TEST(ContactScenes, DrapeOverSphereSkipsTheFreeFallAndStaysIntersectionFree) {
+  Scene scene = library_scene("drape_sphere");
+  EXPECT_DOUBLE_EQ(scene.contact.friction, 0.3);
+  set_edge_length(scene.shells[0].mesh, 0.1);
+  set_edge_length(scene.colliders[0].mesh, 0.1);
+  scene.time.frames = 6;
+  const SceneRun run = simulate(scene);
+  EXPECT_TRUE(run.intersecting_frames.empty())
+      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
+  expect_converged(run);
+  // The cloth starts 5 cm above the ball and falls Δt² g ≈ 1.6 cm per frame: the first frames
+  // have nothing within reach, every evaluation skips the barrier and every step the CCD.
+  const ContactStats& first = run.frames.front().contact;
+  EXPECT_GT(first.barrier_evaluations, 0);
+  EXPECT_EQ(first.barrier_skips, first.barrier_evaluations);
+  EXPECT_GT(first.ccd_evaluations, 0);
+  EXPECT_EQ(first.ccd_skips, first.ccd_evaluations);
+  EXPECT_EQ(first.max_active_pairs, 0);
+  // Later the cloth lies on the ball.
+  const ContactStats& last = run.frames.back().contact;
+  EXPECT_GT(last.max_active_pairs, 0);
+  EXPECT_LT(last.barrier_skips, last.barrier_evaluations);
+}
+
+TEST(ContactScenes, TwistedSheetStaysIntersectionFree) {
+  Scene scene = library_scene("twist_wrap");
+  ASSERT_TRUE(scene.contact.self_contact);
+  set_edge_length(scene.shells[0].mesh, 0.1);
+  scene.time.frames = 14;  // 210° per end: the layers first touch around frame 9
+  const SceneRun run = simulate(scene);
+  EXPECT_TRUE(run.intersecting_frames.empty())
+      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
+  expect_converged(run);
+  EXPECT_GT(most_active_pairs(run), 0);  // the sheet wraps onto itself
+}
+
+TEST(ContactScenes, CrushedCylinderStaysIntersectionFree) {
+  Scene scene = library_scene("cylinder_crush");
+  set_edge_length(scene.shells[0].mesh, 0.02);
+  set_edge_length(scene.colliders[0].mesh, 0.08);
+  scene.time.frames = 4;  // the plate meets the rim in frame 2 and pushes it 2 mm down
+  const SceneRun run = simulate(scene);
+  EXPECT_TRUE(run.intersecting_frames.empty())
+      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
+  expect_converged(run);
+  EXPECT_GT(most_active_pairs(run), 0);  // the plate reaches the rim
+}
+
+TEST(ContactScenes, BunnyPressStaysIntersectionFree) {
+  Scene scene = library_scene("bunny_press");
+  set_edge_length(scene.shells[0].mesh, 0.05);
+  scene.time.frames = 7;  // the bunny comes down 4 mm per frame and meets the sheet in frame 5
+  const SceneRun run = simulate(scene);
+  EXPECT_TRUE(run.intersecting_frames.empty())
+      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
+  expect_converged(run);
+  EXPECT_GT(most_active_pairs(run), 0);  // the bunny reaches the sheet
+}
+
+}  // namespace
+}  // namespace psq
