@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "engine/core/error.hpp"
+#include "engine/progressive/progressive_simulation.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "jobs/level_solver.hpp"
 
@@ -57,15 +58,57 @@ class DirectLevelSolver final : public LevelSolver {
   QuasistaticSimulation simulation_;
 };
 
+/// A progressive solve (engine/progressive) over `depth` levels. Settling steps at the refine
+/// frame are steps like any other: they may repeat a frame number.
+class ProgressiveLevelSolver final : public LevelSolver {
+ public:
+  ProgressiveLevelSolver(const Scene& scene, int depth)
+      : simulation_(scene, settings(scene, depth)) {}
+  int level_count() const override { return simulation_.level_count(); }
+  int level() const override { return simulation_.level(); }
+  int frame() const override { return simulation_.frame(); }
+  int frame_count() const override { return simulation_.frame_count(); }
+  bool level_done() const override { return simulation_.level_done(); }
+  bool finished() const override { return simulation_.finished(); }
+  LevelFrame step(const Progress& progress) override {
+    const ProgressiveStep step = simulation_.step(
+        [&](int, int frame, const NewtonIteration& iteration) { progress(frame, iteration); });
+    const NewtonResult& newton = step.frame.newton;
+    return {.level = step.level,
+            .frame = step.frame.frame,
+            .converged = newton.converged,
+            .iterations = newton.iterations,
+            .step_norm = newton.step_norm,
+            .gradient_norm = newton.gradient_norm,
+            .times = newton.times};
+  }
+  void refine() override { simulation_.refine(); }
+  const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
+  const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
+  const TriMesh& level_rest_mesh() const override { return simulation_.level_rest_mesh(); }
+  Positions finest_positions() const override {
+    return as_positions(simulation_.finest_positions());
+  }
+  /// An in-frame snapshot restarts its frame from the snapshot's positions: the result meets
+  /// the same tolerance but is not bitwise the uninterrupted one.
+  void restore(int level, int frame, const Eigen::VectorXd& positions,
+               const Eigen::VectorXd& previous, int /*iterations_in_frame*/) override {
+    simulation_.restore(level, frame, positions, previous);
+  }
+
+ private:
+  static ProgressiveSettings settings(const Scene& scene, int depth) {
+    ProgressiveSettings result = ProgressiveSettings::from_scene(scene);
+    result.schedule.levels = depth;
+    return result;
+  }
+  ProgressiveSimulation simulation_;
+};
+
 /// The solver of a job with `depth` hierarchy levels on `scene`.
-/// @throws InputError for a depth the program cannot solve yet.
 inline std::unique_ptr<LevelSolver> make_level_solver(const Scene& scene, int depth) {
   if (depth == 1) return std::make_unique<DirectLevelSolver>(scene);
-  // The progressive solver (engine/progressive) plugs in here for depth > 1.
-  throw InputError(
-      fmt::format("depth {}: depth > 1 needs the progressive solver, which this "
-                  "build does not include yet; use depth = 1",
-                  depth));
+  return std::make_unique<ProgressiveLevelSolver>(scene, depth);
 }
 
 }  // namespace psq::jobs

@@ -1,6 +1,7 @@
 // Sweep files: expansion of grids and zipped lists, canonical job ids, and every kind of bad
 // input reported at its line.
 
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -238,10 +239,13 @@ TEST(SweepFile, AnInvalidSceneIsReportedInTheSceneFile) {
       << error_of(file);
 }
 
-TEST(SweepFile, TheDemoSweepExpandsToSixValidJobs) {
+TEST(SweepFile, TheDemoSweepExpandsToEightValidJobsAtTwoDepths) {
   const auto sweep = read_sweep(test::source_dir() / "jobs/sweeps/demo.toml");
   EXPECT_EQ(sweep.name, "demo");
-  ASSERT_EQ(sweep.jobs.size(), 6u);
+  ASSERT_EQ(sweep.jobs.size(), 8u);
+  EXPECT_EQ(std::count_if(sweep.jobs.begin(), sweep.jobs.end(),
+                          [](const auto& job) { return job.depth == 2; }),
+            4);
   EXPECT_EQ(jobs::new_jobs(sweep).front().scene,
             (test::source_dir() / "jobs/scenes/demo_strip.toml").lexically_normal().string());
 }
