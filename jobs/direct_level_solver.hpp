@@ -62,8 +62,8 @@ class DirectLevelSolver final : public LevelSolver {
 /// frame are steps like any other: they may repeat a frame number.
 class ProgressiveLevelSolver final : public LevelSolver {
  public:
-  ProgressiveLevelSolver(const Scene& scene, int depth)
-      : simulation_(scene, settings(scene, depth)) {}
+  ProgressiveLevelSolver(const Scene& scene, int depth, const std::filesystem::path& cache_dir)
+      : simulation_(scene, settings(scene, depth, cache_dir)) {}
   int level_count() const override { return simulation_.level_count(); }
   int level() const override { return simulation_.level(); }
   int frame() const override { return simulation_.frame(); }
@@ -97,18 +97,22 @@ class ProgressiveLevelSolver final : public LevelSolver {
   }
 
  private:
-  static ProgressiveSettings settings(const Scene& scene, int depth) {
+  static ProgressiveSettings settings(const Scene& scene, int depth,
+                                      const std::filesystem::path& cache_dir) {
     ProgressiveSettings result = ProgressiveSettings::from_scene(scene);
     result.schedule.levels = depth;
+    result.cache_dir = cache_dir;
     return result;
   }
   ProgressiveSimulation simulation_;
 };
 
-/// The solver of a job with `depth` hierarchy levels on `scene`.
-inline std::unique_ptr<LevelSolver> make_level_solver(const Scene& scene, int depth) {
+/// The solver of a job with `depth` hierarchy levels on `scene`; hierarchies are cached in
+/// `cache_dir` (empty: built every time).
+inline std::unique_ptr<LevelSolver> make_level_solver(const Scene& scene, int depth,
+                                                      const std::filesystem::path& cache_dir = {}) {
   if (depth == 1) return std::make_unique<DirectLevelSolver>(scene);
-  return std::make_unique<ProgressiveLevelSolver>(scene, depth);
+  return std::make_unique<ProgressiveLevelSolver>(scene, depth, cache_dir);
 }
 
 }  // namespace psq::jobs

@@ -81,8 +81,12 @@ int work_here(const WorkSettings& settings, const std::filesystem::path& databas
   options.lease_seconds = settings.lease_seconds;
   if (!settings.sweep.empty()) options.selection = db::JobSelection::sweep(settings.sweep);
   options.executor = {settings.snapshot_iterations, settings.snapshot_seconds, PSQ_VERSION};
-  const jobs::WorkerSummary summary = jobs::run_worker(
-      database, runs_directory(database), jobs::make_level_solver, options, events, stop_requested);
+  const auto make_solver = [cache = hierarchy_cache_directory(database)](const Scene& scene,
+                                                                         int depth) {
+    return jobs::make_level_solver(scene, depth, cache);
+  };
+  const jobs::WorkerSummary summary = jobs::run_worker(database, runs_directory(database),
+                                                       make_solver, options, events, stop_requested);
   display.clear();
   if (!supervised)
     display.log(fmt::format("psq work: {} done, {} failed{}{}", summary.done, summary.failed,

@@ -25,6 +25,10 @@ std::filesystem::path runs_directory(const std::filesystem::path& database) {
   return std::filesystem::absolute(database).parent_path() / "runs";
 }
 
+std::filesystem::path hierarchy_cache_directory(const std::filesystem::path& database) {
+  return std::filesystem::absolute(database).parent_path() / "cache";
+}
+
 void require_database(const std::filesystem::path& database) {
   if (!std::filesystem::exists(database))
     throw InputError(

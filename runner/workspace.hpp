@@ -21,6 +21,9 @@ void add_database_option(CLI::App& command, std::string& path);
 
 /// The directory of the job outputs that belong to the store at `database`: `runs/` beside it.
 std::filesystem::path runs_directory(const std::filesystem::path& database);
+/// Where built hierarchies are cached: `cache/` beside the database (jobs that vary only
+/// material or thickness share one hierarchy).
+std::filesystem::path hierarchy_cache_directory(const std::filesystem::path& database);
 
 /// Throws InputError naming `database` and how to create it when no store is there.
 void require_database(const std::filesystem::path& database);

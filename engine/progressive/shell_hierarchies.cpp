@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include "engine/core/error.hpp"
+#include "engine/hierarchy/hierarchy_cache.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 
 namespace psq {
@@ -25,8 +26,13 @@ std::vector<MeshHierarchy> build_shell_hierarchies(const ShellSystem& finest,
   hierarchy.levels = settings.schedule.levels;
   hierarchy.vertex_ratio = settings.schedule.vertex_ratio;
   std::vector<MeshHierarchy> out;
-  for (int s = 0; s < static_cast<int>(finest.shells().size()); ++s)
-    out.push_back(build_hierarchy(shell_rest_mesh(finest, s), finest.pin_groups(s), hierarchy));
+  for (int s = 0; s < static_cast<int>(finest.shells().size()); ++s) {
+    const TriMesh mesh = shell_rest_mesh(finest, s);
+    out.push_back(settings.cache_dir.empty()
+                      ? build_hierarchy(mesh, finest.pin_groups(s), hierarchy)
+                      : load_or_build_hierarchy(mesh, finest.pin_groups(s), hierarchy,
+                                                settings.cache_dir));
+  }
   return out;
 }
 

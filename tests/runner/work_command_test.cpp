@@ -55,6 +55,32 @@ class WorkCommand : public ::testing::Test {
   std::string add_errors_;
 };
 
+TEST_F(WorkCommand, DeeperJobsRunLevelByLevelAndShareOneCachedHierarchy) {
+  ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [1e-3, 2e-3]\ndepth = [2]\n"), 0)
+      << add_errors_;
+  const auto work = psq({"work", "--workers", "1"});
+  ASSERT_EQ(work.exit_code, 0) << work.errors;
+  const auto finished = results();
+  ASSERT_EQ(finished.size(), 2u);
+  for (const db::JobResult& r : finished) {
+    EXPECT_EQ(r.job.state, db::JobState::done);
+    ASSERT_EQ(r.levels.size(), 2u);
+    const Checkpoint coarse = read_checkpoint(r.levels[0].checkpoint_path);
+    const Checkpoint fine = read_checkpoint(r.levels[1].checkpoint_path);
+    EXPECT_LT(coarse.positions.rows(), fine.positions.rows());
+    // The coarse level's state is prolonged to the finest mesh; the finest level's is itself.
+    EXPECT_EQ(coarse.finest_positions.rows(), fine.positions.rows());
+    EXPECT_EQ(fine.finest_positions, fine.positions);
+    EXPECT_LT(fine.positions.col(2).minCoeff(), -1e-5);
+  }
+  // Thickness does not change the mesh or the pins: one hierarchy serves both jobs.
+  int cached = 0;
+  for (const auto& entry : fs::directory_iterator(db_.parent_path() / "cache"))
+    cached += entry.path().extension() == ".bin";
+  EXPECT_EQ(cached, 1);
+  expect_store_consistent();
+}
+
 TEST_F(WorkCommand, WorkerProcessesRunASweepAndRecordEveryJob) {
   ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [8e-4, 1e-3, 2e-3]\n"), 0);
   const auto work = psq({"work", "--workers", "2"});
