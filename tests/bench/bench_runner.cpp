@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
   jobs::ExecutorEvents events;
   events.log = [](const std::string& line) { std::cerr << line << '\n'; };
   jobs::JobExecutor executor(
-      store, dir / "psq.db", dir / "runs", jobs::make_level_solver,
+      store, dir / "psq.db", dir / "runs",
+      [](const Scene& scene, int depth) { return jobs::make_level_solver(scene, depth); },
       {.snapshot_iterations = 50, .snapshot_seconds = snapshot_seconds, .code_version = "bench"},
       events, stop);
   const auto start = std::chrono::steady_clock::now();
