@@ -4,14 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "engine/core/error.hpp"
 
 namespace psq {
 namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 /// Gap of IPC's κ_min estimate, as a fraction of the bounding-box diagonal.
 constexpr double kStiffnessProbeGap = 1e-8;
@@ -23,33 +20,14 @@ bool positive_finite(double x) { return x > 0 && std::isfinite(x); }
 
 }  // namespace
 
-double barrier(double s, double s_hat) {
-  if (s <= 0) return kInfinity;
-  if (s >= s_hat) return 0;
-  return -(s - s_hat) * (s - s_hat) * std::log(s / s_hat);
-}
-
-double barrier_first_derivative(double s, double s_hat) {
-  if (s <= 0) return -kInfinity;
-  if (s >= s_hat) return 0;
-  return (s_hat - s) * (2 * std::log(s / s_hat) - s_hat / s + 1);
-}
-
-double barrier_second_derivative(double s, double s_hat) {
-  if (s <= 0) return kInfinity;
-  if (s >= s_hat) return 0;
-  const double r = s_hat / s;
-  return -2 * std::log(s / s_hat) + r * (r + 2) - 3;
-}
-
 StencilDerivatives<12> barrier_of_distance(const StencilDerivatives<12>& distance,
                                            const BarrierBand& band) {
   const double s = band.barrier_argument(distance.value);
   if (!(s > 0))
-    throw NumericalError(fmt::format(
-        "contact barrier: derivatives requested at squared distance {:.6g}, within the "
-        "thickness (ξ² = {:.6g})",
-        distance.value, band.thickness * band.thickness));
+    throw NumericalError(
+        fmt::format("contact barrier: derivatives requested at squared distance {:.6g}, within the "
+                    "thickness (ξ² = {:.6g})",
+                    distance.value, band.thickness * band.thickness));
   const double s_hat = band.barrier_activation();
   return chain_rule(barrier(s, s_hat), barrier_first_derivative(s, s_hat),
                     barrier_second_derivative(s, s_hat), distance);

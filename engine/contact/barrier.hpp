@@ -1,7 +1,8 @@
 #pragma once
-// IPC's log barrier on squared distances, its thickness offset, and the adaptive barrier
-// stiffness κ (Li et al. 2020, "Incremental Potential Contact"; the κ rules follow
-// ipc-toolkit's initial_barrier_stiffness and update_barrier_stiffness).
+// IPC's log barrier on squared distances (b, b′, b″ of engine/core/log_barrier.hpp), its
+// thickness offset, and the adaptive barrier stiffness κ (Li et al. 2020, "Incremental
+// Potential Contact"; the κ rules follow ipc-toolkit's initial_barrier_stiffness and
+// update_barrier_stiffness).
 //
 // Convention: like every distance in engine/contact, the barrier works on SQUARED distances.
 // Its argument s and activation ŝ are squared lengths (m²); the activation distance d̂ and the
@@ -10,19 +11,9 @@
 #include <Eigen/Core>
 
 #include "engine/contact/distance_type.hpp"
+#include "engine/core/log_barrier.hpp"
 
 namespace psq {
-
-/// The unit barrier b(s) = −(s − ŝ)² ln(s/ŝ) for 0 < s < ŝ, 0 for s ≥ ŝ, +∞ for s ≤ 0.
-/// Positive, decreasing and convex on (0, ŝ); b, b′ and b″ all vanish at ŝ, so the barrier is
-/// C² there. A pair's contact potential is κ b (the stiffness is applied by the caller).
-double barrier(double s, double s_hat);
-
-/// b′(s) = (ŝ − s)(2 ln(s/ŝ) − ŝ/s + 1) for 0 < s < ŝ, 0 for s ≥ ŝ, −∞ for s ≤ 0.
-double barrier_first_derivative(double s, double s_hat);
-
-/// b″(s) = −2 ln(s/ŝ) + (ŝ/s)(ŝ/s + 2) − 3 for 0 < s < ŝ, 0 for s ≥ ŝ, +∞ for s ≤ 0.
-double barrier_second_derivative(double s, double s_hat);
 
 /// Where the barrier acts, in unsigned distances: it is infinite at the thickness ξ and zero
 /// from ξ + d̂ on. The thickness enters as an offset of the squared distance d,

@@ -70,12 +70,6 @@ BendingEnergy::BendingEnergy(const TriMesh& rest, const MeshTopology& topology,
   }
 }
 
-HingePositions BendingEnergy::positions(const Eigen::VectorXd& x, std::size_t h) const {
-  HingePositions corners;
-  for (int a = 0; a < 4; ++a) corners.col(a) = x.segment<3>(3 * stencils_[4 * h + a]);
-  return corners;
-}
-
 void BendingEnergy::check(const Eigen::VectorXd& x) const {
   check_positions(x, vertex_offset_, vertex_count_, "bending");
 }
@@ -83,7 +77,7 @@ void BendingEnergy::check(const Eigen::VectorXd& x) const {
 double BendingEnergy::value(const Eigen::VectorXd& x) const {
   check(x);
   return parallel_element_sum(rest_.size(), [&](std::size_t h) {
-    return hinge_energy(positions(x, h), rest_[h], stiffness_);
+    return hinge_energy(element_positions<4>(x, stencils_, h), rest_[h], stiffness_);
   });
 }
 
@@ -91,7 +85,10 @@ void BendingEnergy::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) c
   check(x);
   add_element_gradients<4>(
       stencils_,
-      [&](std::size_t h) { return hinge_gradient(positions(x, h), rest_[h], stiffness_); }, g);
+      [&](std::size_t h) {
+        return hinge_gradient(element_positions<4>(x, stencils_, h), rest_[h], stiffness_);
+      },
+      g);
 }
 
 void BendingEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& out,
@@ -100,7 +97,8 @@ void BendingEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& out,
   fill_element_hessians<4>(
       stencils_,
       [&](std::size_t h) {
-        return hinge_hessian(positions(x, h), rest_[h], stiffness_, project_psd);
+        return hinge_hessian(element_positions<4>(x, stencils_, h), rest_[h], stiffness_,
+                             project_psd);
       },
       out);
 }

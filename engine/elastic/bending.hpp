@@ -70,7 +70,6 @@ class BendingEnergy {
   [[nodiscard]] int hinge_count() const { return static_cast<int>(rest_.size()); }
 
  private:
-  [[nodiscard]] HingePositions positions(const Eigen::VectorXd& x, std::size_t h) const;
   void check(const Eigen::VectorXd& x) const;
 
   double stiffness_;

@@ -43,6 +43,18 @@ double parallel_element_sum(std::size_t count, const Term& term) {
       [](double a, double b) { return a + b; });
 }
 
+/// The positions of element e's vertices as columns, gathered from the flat position vector x
+/// (size 3N); `stencils` lists StencilSize global vertices per element.
+template <int StencilSize>
+Eigen::Matrix<double, 3, StencilSize> element_positions(const Eigen::VectorXd& x,
+                                                        const std::vector<int>& stencils,
+                                                        std::size_t e) {
+  Eigen::Matrix<double, 3, StencilSize> corners;
+  for (int a = 0; a < StencilSize; ++a)
+    corners.col(a) = x.segment<3>(3 * stencils[StencilSize * e + a]);
+  return corners;
+}
+
 /// g += Σ_e (element e's gradient scattered to its stencil). `stencils` lists StencilSize
 /// global vertices per element; gradient(e) returns the 3·StencilSize vector ordered like the
 /// stencil. Element gradients are computed in parallel into a buffer, then added serially in

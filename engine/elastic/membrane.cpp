@@ -1,7 +1,5 @@
 #include "engine/elastic/membrane.hpp"
 
-#include <fmt/format.h>
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -23,42 +21,7 @@ void require_regular(const DeformationGradient& F) {
     throw NumericalError("membrane: degenerate triangle (J = 0), derivatives undefined");
 }
 
-/// vec(a bᵀ) for a 3×2 matrix stored column by column.
-Eigen::Matrix<double, 6, 1> vec_outer(const Eigen::Vector3d& a, const Eigen::Vector2d& b) {
-  Eigen::Matrix<double, 6, 1> v;
-  v << b[0] * a, b[1] * a;
-  return v;
-}
-
-/// ∂vec(F)/∂(x0, x1, x2): block (k, i) is β_i[k]·I.
-Eigen::Matrix<double, 6, 9> deformation_gradient_jacobian(const MembraneRest& rest) {
-  const Eigen::Vector2d beta1 = rest.rest_frame_inverse.row(0).transpose();
-  const Eigen::Vector2d beta2 = rest.rest_frame_inverse.row(1).transpose();
-  const Eigen::Vector2d beta[3] = {-beta1 - beta2, beta1, beta2};
-  Eigen::Matrix<double, 6, 9> a = Eigen::Matrix<double, 6, 9>::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < 2; ++k) a.block<3, 3>(3 * k, 3 * i).diagonal().setConstant(beta[i][k]);
-  return a;
-}
-
 }  // namespace
-
-MembraneRest membrane_rest(const TrianglePositions& rest) {
-  // D holds the rest edges in an orthonormal frame whose first axis is edge 1.
-  const Eigen::Vector3d e1 = rest.col(1) - rest.col(0);
-  const Eigen::Vector3d e2 = rest.col(2) - rest.col(0);
-  const double l1 = e1.norm();
-  const double twice_area = e1.cross(e2).norm();
-  Eigen::Matrix2d d;
-  d << l1, e1.dot(e2) / l1, 0.0, twice_area / l1;
-  return {d.inverse(), 0.5 * twice_area};
-}
-
-DeformationGradient deformation_gradient(const TrianglePositions& x, const MembraneRest& rest) {
-  DeformationGradient edges;
-  edges << x.col(1) - x.col(0), x.col(2) - x.col(0);
-  return edges * rest.rest_frame_inverse;
-}
 
 double membrane_density(const DeformationGradient& F, const PlaneStressLame& lame) {
   const double det = gram_determinant(F);
@@ -97,7 +60,7 @@ DeformationGradientMatrix membrane_stress_derivative(const DeformationGradient& 
   const double lambda = lame.lambda;
   const double c = lambda * std::log(s1 * s2) - mu;
   DeformationGradientMatrix h = DeformationGradientMatrix::Zero();
-  const auto add_mode = [&](double eigenvalue, const Eigen::Matrix<double, 6, 1>& mode) {
+  const auto add_mode = [&](double eigenvalue, const DeformationGradientVector& mode) {
     if (project_psd && eigenvalue < 0) return;
     h.noalias() += eigenvalue * mode * mode.transpose();
   };
@@ -126,47 +89,24 @@ double membrane_triangle_energy(const TrianglePositions& x, const MembraneRest& 
 
 TriangleVector membrane_triangle_gradient(const TrianglePositions& x, const MembraneRest& rest,
                                           const PlaneStressLame& lame, double thickness) {
-  const DeformationGradient stress = membrane_stress(deformation_gradient(x, rest), lame);
-  const Eigen::Matrix<double, 6, 1> stress_vec = stress.reshaped();
-  return thickness * rest.area * deformation_gradient_jacobian(rest).transpose() * stress_vec;
+  return pull_back_stress(membrane_stress(deformation_gradient(x, rest), lame), rest,
+                          thickness * rest.area);
 }
 
 TriangleMatrix membrane_triangle_hessian(const TrianglePositions& x, const MembraneRest& rest,
                                          const PlaneStressLame& lame, double thickness,
                                          bool project_psd) {
-  const Eigen::Matrix<double, 6, 9> a = deformation_gradient_jacobian(rest);
-  const DeformationGradientMatrix h_f =
-      membrane_stress_derivative(deformation_gradient(x, rest), lame, project_psd);
-  return thickness * rest.area * a.transpose() * h_f * a;
+  return pull_back_stress_derivative(
+      membrane_stress_derivative(deformation_gradient(x, rest), lame, project_psd), rest,
+      thickness * rest.area);
 }
 
 MembraneEnergy::MembraneEnergy(const TriMesh& rest, const Material& material, int vertex_offset)
     : lame_(plane_stress_lame(material)),
       thickness_(material.thickness),
       vertex_offset_(vertex_offset),
-      vertex_count_(rest.vertex_count()) {
-  const int n = rest.triangle_count();
-  stencils_.reserve(3 * static_cast<std::size_t>(n));
-  rest_.reserve(n);
-  for (int t = 0; t < n; ++t) {
-    TrianglePositions corners;
-    for (int a = 0; a < 3; ++a) {
-      corners.col(a) = rest.vertices.row(rest.triangles(t, a)).transpose();
-      stencils_.push_back(vertex_offset + rest.triangles(t, a));
-    }
-    rest_.push_back(membrane_rest(corners));
-    if (!(rest_.back().area > 0))
-      throw InputError(fmt::format("membrane: rest triangle {} (vertices {}, {}, {}) has zero area",
-                                   t, rest.triangles(t, 0), rest.triangles(t, 1),
-                                   rest.triangles(t, 2)));
-  }
-}
-
-TrianglePositions MembraneEnergy::positions(const Eigen::VectorXd& x, std::size_t t) const {
-  TrianglePositions corners;
-  for (int a = 0; a < 3; ++a) corners.col(a) = x.segment<3>(3 * stencils_[3 * t + a]);
-  return corners;
-}
+      vertex_count_(rest.vertex_count()),
+      triangles_(rest, vertex_offset, "membrane") {}
 
 void MembraneEnergy::check(const Eigen::VectorXd& x) const {
   check_positions(x, vertex_offset_, vertex_count_, "membrane");
@@ -174,17 +114,19 @@ void MembraneEnergy::check(const Eigen::VectorXd& x) const {
 
 double MembraneEnergy::value(const Eigen::VectorXd& x) const {
   check(x);
-  return parallel_element_sum(rest_.size(), [&](std::size_t t) {
-    return membrane_triangle_energy(positions(x, t), rest_[t], lame_, thickness_);
+  return parallel_element_sum(triangles_.size(), [&](std::size_t t) {
+    return membrane_triangle_energy(triangles_.positions(x, t), triangles_.rest(t), lame_,
+                                    thickness_);
   });
 }
 
 void MembraneEnergy::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const {
   check(x);
   add_element_gradients<3>(
-      stencils_,
+      triangles_.stencils(),
       [&](std::size_t t) {
-        return membrane_triangle_gradient(positions(x, t), rest_[t], lame_, thickness_);
+        return membrane_triangle_gradient(triangles_.positions(x, t), triangles_.rest(t), lame_,
+                                          thickness_);
       },
       g);
 }
@@ -193,9 +135,10 @@ void MembraneEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& out,
                              bool project_psd) const {
   check(x);
   fill_element_hessians<3>(
-      stencils_,
+      triangles_.stencils(),
       [&](std::size_t t) {
-        return membrane_triangle_hessian(positions(x, t), rest_[t], lame_, thickness_, project_psd);
+        return membrane_triangle_hessian(triangles_.positions(x, t), triangles_.rest(t), lame_,
+                                         thickness_, project_psd);
       },
       out);
 }

@@ -1,39 +1,20 @@
 #pragma once
 // Neo-Hookean membrane energy of a shell (DESIGN.md §4), per triangle:
 //   Ψ = h·Ā·ψ(F),  ψ(F) = μ/2 (‖F‖² − 2) − μ ln J + λ/2 (ln J)²,  J = √det(FᵀF),
-// with F = E D⁻¹ the 3×2 deformation gradient: E = [x1 − x0, x2 − x0] the current edge
-// matrix and D any 2×2 matrix with DᵀD = ā = ĒᵀĒ (ψ sees F only through FᵀF, so the choice of
-// rest frame is free). Then ‖F‖² = tr(ā⁻¹a) and J² = det a / det ā, the formula of DESIGN.md.
-// μ, λ are the plane-stress Lamé parameters.
+// with F = E D⁻¹ the 3×2 deformation gradient (deformation_gradient.hpp): E = [x1 − x0, x2 − x0]
+// the current edge matrix and D any 2×2 matrix with DᵀD = ā = ĒᵀĒ (ψ sees F only through FᵀF, so
+// the choice of rest frame is free). Then ‖F‖² = tr(ā⁻¹a) and J² = det a / det ā, the formula of
+// DESIGN.md. μ, λ are the plane-stress Lamé parameters.
 
 #include <Eigen/Core>
-#include <vector>
 
 #include "engine/core/element_matrices.hpp"
+#include "engine/elastic/deformation_gradient.hpp"
 #include "engine/elastic/lame.hpp"
 #include "engine/elastic/material.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 
 namespace psq {
-
-using DeformationGradient = Eigen::Matrix<double, 3, 2>;
-using DeformationGradientMatrix = Eigen::Matrix<double, 6, 6>;  ///< on column-major vec(F)
-/// Positions of a triangle's vertices as columns x0, x1, x2.
-using TrianglePositions = Eigen::Matrix3d;
-using TriangleVector = Eigen::Matrix<double, 9, 1>;
-using TriangleMatrix = Eigen::Matrix<double, 9, 9>;
-
-/// Rest data of one triangle.
-struct MembraneRest {
-  Eigen::Matrix2d rest_frame_inverse;  ///< D⁻¹ with DᵀD = ā (D upper triangular)
-  double area;                         ///< Ā
-};
-
-/// Rest data of a triangle. A degenerate rest triangle gets area 0 and an unusable frame.
-MembraneRest membrane_rest(const TrianglePositions& rest);
-
-/// F = [x1 − x0, x2 − x0] D⁻¹.
-DeformationGradient deformation_gradient(const TrianglePositions& x, const MembraneRest& rest);
 
 /// ψ(F) as above; +∞ when det(FᵀF) ≤ 0 (a degenerate triangle), so line searches reject it.
 double membrane_density(const DeformationGradient& F, const PlaneStressLame& lame);
@@ -57,13 +38,12 @@ DeformationGradientMatrix membrane_stress_derivative(const DeformationGradient& 
 double membrane_triangle_energy(const TrianglePositions& x, const MembraneRest& rest,
                                 const PlaneStressLame& lame, double thickness);
 
-/// ∂Ψ/∂(x0, x1, x2) = h·Ā·(P β0, P β1, P β2), P = ∂ψ/∂F and β_i the rows of ∂F/∂x_i
-/// (β1, β2 the rows of D⁻¹, β0 = −β1 − β2).
+/// ∂Ψ/∂(x0, x1, x2) = h·Ā·Aᵀ vec(P), P = ∂ψ/∂F (pull_back_stress).
 TriangleVector membrane_triangle_gradient(const TrianglePositions& x, const MembraneRest& rest,
                                           const PlaneStressLame& lame, double thickness);
 
-/// ∂²Ψ/∂x² = h·Ā·Aᵀ (∂²ψ/∂F²) A with A = ∂vec(F)/∂x. The map A is onto, so projecting
-/// ∂²ψ/∂F² (6×6) makes the 9×9 block PSD, and leaves it unchanged when it already is.
+/// ∂²Ψ/∂x² = h·Ā·Aᵀ (∂²ψ/∂F²) A (pull_back_stress_derivative). The map A is onto, so
+/// projecting ∂²ψ/∂F² (6×6) makes the 9×9 block PSD, and leaves it unchanged when it already is.
 TriangleMatrix membrane_triangle_hessian(const TrianglePositions& x, const MembraneRest& rest,
                                          const PlaneStressLame& lame, double thickness,
                                          bool project_psd);
@@ -84,18 +64,16 @@ class MembraneEnergy {
   /// project_psd is false. Reuses out's storage when its stencils already match.
   void hessian(const Eigen::VectorXd& x, ElementMatrices& out, bool project_psd = true) const;
 
-  [[nodiscard]] int triangle_count() const { return static_cast<int>(rest_.size()); }
+  [[nodiscard]] int triangle_count() const { return static_cast<int>(triangles_.size()); }
 
  private:
-  [[nodiscard]] TrianglePositions positions(const Eigen::VectorXd& x, std::size_t t) const;
   void check(const Eigen::VectorXd& x) const;
 
   PlaneStressLame lame_;
   double thickness_;
   int vertex_offset_;
   int vertex_count_;
-  std::vector<int> stencils_;  ///< 3 global vertices per triangle
-  std::vector<MembraneRest> rest_;
+  TriangleElements triangles_;
 };
 
 }  // namespace psq

@@ -270,26 +270,25 @@ MidedgeBendingEnergy::MidedgeBendingEnergy(const TriMesh& rest, const MeshTopolo
   }
 }
 
-MidedgePositions MidedgeBendingEnergy::positions(const Eigen::VectorXd& x, std::size_t e) const {
-  MidedgePositions corners;
-  for (int a = 0; a < 6; ++a) corners.col(a) = x.segment<3>(3 * stencils_[6 * e + a]);
-  return corners;
-}
-
 void MidedgeBendingEnergy::check(const Eigen::VectorXd& x) const {
   check_positions(x, vertex_offset_, vertex_count_, "mid-edge bending");
 }
 
 double MidedgeBendingEnergy::value(const Eigen::VectorXd& x) const {
   check(x);
-  return parallel_element_sum(
-      rest_.size(), [&](std::size_t e) { return midedge_energy(positions(x, e), rest_[e]); });
+  return parallel_element_sum(rest_.size(), [&](std::size_t e) {
+    return midedge_energy(element_positions<6>(x, stencils_, e), rest_[e]);
+  });
 }
 
 void MidedgeBendingEnergy::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const {
   check(x);
   add_element_gradients<6>(
-      stencils_, [&](std::size_t e) { return midedge_gradient(positions(x, e), rest_[e]); }, g);
+      stencils_,
+      [&](std::size_t e) {
+        return midedge_gradient(element_positions<6>(x, stencils_, e), rest_[e]);
+      },
+      g);
 }
 
 void MidedgeBendingEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& out,
@@ -297,7 +296,10 @@ void MidedgeBendingEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& ou
   check(x);
   fill_element_hessians<6>(
       stencils_,
-      [&](std::size_t e) { return midedge_hessian(positions(x, e), rest_[e], project_psd); }, out);
+      [&](std::size_t e) {
+        return midedge_hessian(element_positions<6>(x, stencils_, e), rest_[e], project_psd);
+      },
+      out);
 }
 
 }  // namespace psq

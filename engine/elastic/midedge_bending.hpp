@@ -139,7 +139,6 @@ class MidedgeBendingEnergy {
   [[nodiscard]] int element_count() const { return static_cast<int>(rest_.size()); }
 
  private:
-  [[nodiscard]] MidedgePositions positions(const Eigen::VectorXd& x, std::size_t e) const;
   void check(const Eigen::VectorXd& x) const;
 
   int vertex_offset_;

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "engine/core/error.hpp"
+#include "engine/core/log_barrier.hpp"
 #include "engine/elastic/element_loop.hpp"
 
 namespace psq {
@@ -54,22 +55,22 @@ void require_below_limit(double stretch, const StrainLimitBand& band) {
         stretch, band.limit));
 }
 
-/// vec(a bᵀ) for a 3×2 matrix stored column by column.
-Eigen::Matrix<double, 6, 1> vec_outer(const Eigen::Vector3d& a, const Eigen::Vector2d& b) {
-  Eigen::Matrix<double, 6, 1> v;
-  v << b[0] * a, b[1] * a;
-  return v;
+/// The band, or InputError unless 0 < ŝ < s̄ (finite).
+const StrainLimitBand& checked_band(const StrainLimitBand& band) {
+  if (!(band.band_start > 0 && band.limit > band.band_start && std::isfinite(band.limit)))
+    throw InputError(fmt::format(
+        "strain limit: limit {} and band start {} must satisfy 0 < band start < limit (set "
+        "the strain limit above 1, e.g. 1.05)",
+        band.limit, band.band_start));
+  return band;
 }
 
-/// ∂vec(F)/∂(x0, x1, x2): block (k, i) is β_i[k]·I, β1, β2 the rows of D⁻¹, β0 = −β1 − β2.
-Eigen::Matrix<double, 6, 9> deformation_gradient_jacobian(const MembraneRest& rest) {
-  const Eigen::Vector2d beta1 = rest.rest_frame_inverse.row(0).transpose();
-  const Eigen::Vector2d beta2 = rest.rest_frame_inverse.row(1).transpose();
-  const Eigen::Vector2d beta[3] = {-beta1 - beta2, beta1, beta2};
-  Eigen::Matrix<double, 6, 9> a = Eigen::Matrix<double, 6, 9>::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < 2; ++k) a.block<3, 3>(3 * k, 3 * i).diagonal().setConstant(beta[i][k]);
-  return a;
+/// κ_s, or InputError unless it is positive and finite.
+double checked_stiffness(double stiffness) {
+  if (!(stiffness > 0 && std::isfinite(stiffness)))
+    throw InputError(
+        fmt::format("strain limit: stiffness κ_s = {} must be positive and finite", stiffness));
+  return stiffness;
 }
 
 /// σ₁ of the triangle at x.
@@ -114,25 +115,17 @@ Eigen::Vector2d principal_stretches(const DeformationGradient& F) {
 }
 
 double strain_limit_barrier(double sigma, const StrainLimitBand& band) {
-  const double r = normalized_slack(sigma, band);
-  if (r <= 0) return kInfinity;
-  if (r >= 1) return 0;
-  return -(r - 1) * (r - 1) * std::log(r);
+  return barrier(normalized_slack(sigma, band), 1);
 }
 
 double strain_limit_barrier_first_derivative(double sigma, const StrainLimitBand& band) {
-  const double r = normalized_slack(sigma, band);
-  if (r <= 0) return kInfinity;
-  if (r >= 1) return 0;
-  return -(1 - r) * (2 * std::log(r) + 1 - 1 / r) / band.width();
+  // dr/dσ = −1/δ.
+  return -barrier_first_derivative(normalized_slack(sigma, band), 1) / band.width();
 }
 
 double strain_limit_barrier_second_derivative(double sigma, const StrainLimitBand& band) {
-  const double r = normalized_slack(sigma, band);
-  if (r <= 0) return kInfinity;
-  if (r >= 1) return 0;
-  const double inverse = 1 / r;
-  return (-2 * std::log(r) + inverse * (inverse + 2) - 3) / (band.width() * band.width());
+  return barrier_second_derivative(normalized_slack(sigma, band), 1) /
+         (band.width() * band.width());
 }
 
 double strain_limit_density(const DeformationGradient& F, const StrainLimitBand& band) {
@@ -167,7 +160,7 @@ DeformationGradientMatrix strain_limit_stress_derivative(const DeformationGradie
                                   strain_limit_barrier_second_derivative(sigma[1], band));
 
   DeformationGradientMatrix h = DeformationGradientMatrix::Zero();
-  const auto add_mode = [&](double eigenvalue, const Eigen::Matrix<double, 6, 1>& mode) {
+  const auto add_mode = [&](double eigenvalue, const DeformationGradientVector& mode) {
     if (eigenvalue == 0 || (project_psd && eigenvalue < 0)) return;
     h.noalias() += eigenvalue * mode * mode.transpose();
   };
@@ -195,18 +188,16 @@ double strain_limit_triangle_energy(const TrianglePositions& x, const MembraneRe
 
 TriangleVector strain_limit_triangle_gradient(const TrianglePositions& x, const MembraneRest& rest,
                                               const StrainLimitBand& band, double stiffness) {
-  const DeformationGradient stress = strain_limit_stress(deformation_gradient(x, rest), band);
-  const Eigen::Matrix<double, 6, 1> stress_vec = stress.reshaped();
-  return stiffness * rest.area * deformation_gradient_jacobian(rest).transpose() * stress_vec;
+  return pull_back_stress(strain_limit_stress(deformation_gradient(x, rest), band), rest,
+                          stiffness * rest.area);
 }
 
 TriangleMatrix strain_limit_triangle_hessian(const TrianglePositions& x, const MembraneRest& rest,
                                              const StrainLimitBand& band, double stiffness,
                                              bool project_psd) {
-  const Eigen::Matrix<double, 6, 9> a = deformation_gradient_jacobian(rest);
-  const DeformationGradientMatrix h_f =
-      strain_limit_stress_derivative(deformation_gradient(x, rest), band, project_psd);
-  return stiffness * rest.area * a.transpose() * h_f * a;
+  return pull_back_stress_derivative(
+      strain_limit_stress_derivative(deformation_gradient(x, rest), band, project_psd), rest,
+      stiffness * rest.area);
 }
 
 double strain_limit_feasible_step(const TrianglePositions& x, const TrianglePositions& dx,
@@ -228,41 +219,14 @@ double update_strain_limit_stiffness(double stiffness, double previous_min_slack
 
 StrainLimitEnergy::StrainLimitEnergy(const TriMesh& rest, const StrainLimitBand& band,
                                      double stiffness, int vertex_offset)
-    : band_(band), vertex_offset_(vertex_offset), vertex_count_(rest.vertex_count()) {
-  if (!(band.band_start > 0 && band.limit > band.band_start && std::isfinite(band.limit)))
-    throw InputError(fmt::format(
-        "strain limit: limit {} and band start {} must satisfy 0 < band start < limit (set "
-        "the strain limit above 1, e.g. 1.05)",
-        band.limit, band.band_start));
-  set_stiffness(stiffness);
-  const int n = rest.triangle_count();
-  stencils_.reserve(3 * static_cast<std::size_t>(n));
-  rest_.reserve(n);
-  for (int t = 0; t < n; ++t) {
-    TrianglePositions corners;
-    for (int a = 0; a < 3; ++a) {
-      corners.col(a) = rest.vertices.row(rest.triangles(t, a)).transpose();
-      stencils_.push_back(vertex_offset + rest.triangles(t, a));
-    }
-    rest_.push_back(membrane_rest(corners));
-    if (!(rest_.back().area > 0))
-      throw InputError(
-          fmt::format("strain limit: rest triangle {} (vertices {}, {}, {}) has zero area", t,
-                      rest.triangles(t, 0), rest.triangles(t, 1), rest.triangles(t, 2)));
-  }
-}
+    : band_(checked_band(band)),
+      stiffness_(checked_stiffness(stiffness)),
+      vertex_offset_(vertex_offset),
+      vertex_count_(rest.vertex_count()),
+      triangles_(rest, vertex_offset, "strain limit") {}
 
 void StrainLimitEnergy::set_stiffness(double stiffness) {
-  if (!(stiffness > 0 && std::isfinite(stiffness)))
-    throw InputError(
-        fmt::format("strain limit: stiffness κ_s = {} must be positive and finite", stiffness));
-  stiffness_ = stiffness;
-}
-
-TrianglePositions StrainLimitEnergy::positions(const Eigen::VectorXd& x, std::size_t t) const {
-  TrianglePositions corners;
-  for (int a = 0; a < 3; ++a) corners.col(a) = x.segment<3>(3 * stencils_[3 * t + a]);
-  return corners;
+  stiffness_ = checked_stiffness(stiffness);
 }
 
 void StrainLimitEnergy::check(const Eigen::VectorXd& x) const {
@@ -270,25 +234,26 @@ void StrainLimitEnergy::check(const Eigen::VectorXd& x) const {
 }
 
 StrainLimitEnergy::ActiveSet StrainLimitEnergy::active_set(const Eigen::VectorXd& x) const {
-  std::vector<char> active(rest_.size());
-  parallel_for_elements(rest_.size(), [&](std::size_t t) {
-    active[t] =
-        largest_stretch(positions(x, t), rest_[t]) > band_.band_start * (1 + kActivityTolerance);
+  std::vector<char> active(triangles_.size());
+  parallel_for_elements(triangles_.size(), [&](std::size_t t) {
+    active[t] = largest_stretch(triangles_.positions(x, t), triangles_.rest(t)) >
+                band_.band_start * (1 + kActivityTolerance);
   });
   ActiveSet set;
   for (std::size_t t = 0; t < active.size(); ++t) {
     if (!active[t]) continue;
     set.triangles.push_back(t);
-    set.stencils.insert(set.stencils.end(), stencils_.begin() + 3 * t,
-                        stencils_.begin() + 3 * t + 3);
+    const auto stencil = triangles_.stencils().begin() + 3 * t;
+    set.stencils.insert(set.stencils.end(), stencil, stencil + 3);
   }
   return set;
 }
 
 double StrainLimitEnergy::value(const Eigen::VectorXd& x) const {
   check(x);
-  return parallel_element_sum(rest_.size(), [&](std::size_t t) {
-    return strain_limit_triangle_energy(positions(x, t), rest_[t], band_, stiffness_);
+  return parallel_element_sum(triangles_.size(), [&](std::size_t t) {
+    return strain_limit_triangle_energy(triangles_.positions(x, t), triangles_.rest(t), band_,
+                                        stiffness_);
   });
 }
 
@@ -299,7 +264,8 @@ void StrainLimitEnergy::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& 
       active.stencils,
       [&](std::size_t e) {
         const std::size_t t = active.triangles[e];
-        return strain_limit_triangle_gradient(positions(x, t), rest_[t], band_, stiffness_);
+        return strain_limit_triangle_gradient(triangles_.positions(x, t), triangles_.rest(t), band_,
+                                              stiffness_);
       },
       g);
 }
@@ -312,8 +278,8 @@ void StrainLimitEnergy::hessian(const Eigen::VectorXd& x, ElementMatrices& out,
       active.stencils,
       [&](std::size_t e) {
         const std::size_t t = active.triangles[e];
-        return strain_limit_triangle_hessian(positions(x, t), rest_[t], band_, stiffness_,
-                                             project_psd);
+        return strain_limit_triangle_hessian(triangles_.positions(x, t), triangles_.rest(t), band_,
+                                             stiffness_, project_psd);
       },
       out);
 }
@@ -325,24 +291,27 @@ double StrainLimitEnergy::max_feasible_step(const Eigen::VectorXd& x,
   // σ₁ is convex along the line: a triangle below the limit at both ends of [0, 1] is below
   // it all along and cannot bound the step. Only the others are bisected, each up to the
   // bound found so far (a triangle below the limit at that bound returns it at once).
-  std::vector<char> crosses(rest_.size());
-  parallel_for_elements(rest_.size(), [&](std::size_t t) {
-    const TrianglePositions corners = positions(x, t);
-    require_feasible_start(corners, rest_[t], band_.limit);
-    crosses[t] = largest_stretch_along(corners, positions(dx, t), rest_[t], 1) >= band_.limit;
+  std::vector<char> crosses(triangles_.size());
+  parallel_for_elements(triangles_.size(), [&](std::size_t t) {
+    const TrianglePositions corners = triangles_.positions(x, t);
+    require_feasible_start(corners, triangles_.rest(t), band_.limit);
+    crosses[t] = largest_stretch_along(corners, triangles_.positions(dx, t), triangles_.rest(t),
+                                       1) >= band_.limit;
   });
   double step = 1;
-  for (std::size_t t = 0; t < rest_.size(); ++t)
+  for (std::size_t t = 0; t < triangles_.size(); ++t)
     if (crosses[t])
-      step = feasible_step_up_to(positions(x, t), positions(dx, t), rest_[t], band_.limit, step);
+      step = feasible_step_up_to(triangles_.positions(x, t), triangles_.positions(dx, t),
+                                 triangles_.rest(t), band_.limit, step);
   return step;
 }
 
 double StrainLimitEnergy::min_slack(const Eigen::VectorXd& x) const {
   check(x);
   double slack = kInfinity;
-  for (std::size_t t = 0; t < rest_.size(); ++t)
-    slack = std::min(slack, band_.limit - largest_stretch(positions(x, t), rest_[t]));
+  for (std::size_t t = 0; t < triangles_.size(); ++t)
+    slack = std::min(slack,
+                     band_.limit - largest_stretch(triangles_.positions(x, t), triangles_.rest(t)));
   return slack;
 }
 

@@ -2,13 +2,12 @@
 // Strain limiting on the singular values of each triangle's deformation gradient (Li et al.
 // 2021, "Codimensional Incremental Potential Contact", §6; Codim-IPC's INEXT.h). A barrier
 // keeps every singular value σ of the 3×2 deformation gradient F (the membrane's F, see
-// membrane.hpp) strictly below the limit s̄, acting only inside a band (ŝ, s̄):
+// deformation_gradient.hpp) strictly below the limit s̄, acting only inside a band (ŝ, s̄):
 //   S = κ_s Σ_triangles Ā Σ_{k=1,2} g(σ_k),   g(σ) = b̃((s̄ − σ)/δ),   δ = s̄ − ŝ,
 //   b̃(r) = −(r − 1)² ln r  (0 < r < 1),   b̃ = 0 for r ≥ 1,   +∞ for r ≤ 0.
-// b̃ is IPC's log barrier with unit activation (b(s, ŝ)/ŝ² of contact/barrier.hpp, restated
-// here because the elastic module does not link the contact module): g is C² at ŝ, positive,
-// increasing and convex on (ŝ, s̄), and infinite at s̄. Ā is the rest area, κ_s (N/m) an energy
-// per unit rest area.
+// b̃(r) = b(r, 1) is IPC's log barrier with unit activation (engine/core/log_barrier.hpp): g is
+// C² at ŝ, positive, increasing and convex on (ŝ, s̄), and infinite at s̄. Ā is the rest area,
+// κ_s (N/m) an energy per unit rest area.
 //
 // Stiffness (Codim-IPC): κ_s starts at a scene value (initial_strain_limit_stiffness gives a
 // scale) and doubles, up to a cap, whenever the tightest triangle was within 1e-4 δ of the
@@ -20,7 +19,7 @@
 #include <vector>
 
 #include "engine/core/element_matrices.hpp"
-#include "engine/elastic/membrane.hpp"
+#include "engine/elastic/deformation_gradient.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 
 namespace psq {
@@ -71,12 +70,12 @@ DeformationGradientMatrix strain_limit_stress_derivative(const DeformationGradie
 double strain_limit_triangle_energy(const TrianglePositions& x, const MembraneRest& rest,
                                     const StrainLimitBand& band, double stiffness);
 
-/// ∂/∂(x0, x1, x2) of strain_limit_triangle_energy: κ_s Ā (P β0, P β1, P β2) with P = ∂φ/∂F
-/// and β_i the rows of ∂F/∂x_i, as for the membrane.
+/// ∂/∂(x0, x1, x2) of strain_limit_triangle_energy: κ_s Ā Aᵀ vec(P) with P = ∂φ/∂F
+/// (pull_back_stress).
 TriangleVector strain_limit_triangle_gradient(const TrianglePositions& x, const MembraneRest& rest,
                                               const StrainLimitBand& band, double stiffness);
 
-/// κ_s Ā Aᵀ (∂²φ/∂F²) A with A = ∂vec(F)/∂x; PSD when projected.
+/// κ_s Ā Aᵀ (∂²φ/∂F²) A (pull_back_stress_derivative); PSD when projected.
 TriangleMatrix strain_limit_triangle_hessian(const TrianglePositions& x, const MembraneRest& rest,
                                              const StrainLimitBand& band, double stiffness,
                                              bool project_psd);
@@ -132,10 +131,9 @@ class StrainLimitEnergy {
   [[nodiscard]] double stiffness() const { return stiffness_; }
   void set_stiffness(double stiffness);
   [[nodiscard]] const StrainLimitBand& band() const { return band_; }
-  [[nodiscard]] int triangle_count() const { return static_cast<int>(rest_.size()); }
+  [[nodiscard]] int triangle_count() const { return static_cast<int>(triangles_.size()); }
 
  private:
-  [[nodiscard]] TrianglePositions positions(const Eigen::VectorXd& x, std::size_t t) const;
   /// The triangles inside the band and their stencils (3 global vertices each).
   struct ActiveSet {
     std::vector<std::size_t> triangles;
@@ -148,8 +146,7 @@ class StrainLimitEnergy {
   double stiffness_;
   int vertex_offset_;
   int vertex_count_;
-  std::vector<int> stencils_;  ///< 3 global vertices per triangle
-  std::vector<MembraneRest> rest_;
+  TriangleElements triangles_;
 };
 
 }  // namespace psq

@@ -14,6 +14,8 @@
 namespace psq {
 namespace {
 
+using test::curved_shell;
+using test::CurvedShell;
 using test::fd_gradient;
 using test::fd_jacobian;
 using test::relative_error;
@@ -87,8 +89,8 @@ TEST(HingeEnergy, SolverHessianIsTheGaussNewtonTermAndPsd) {
       const HingeMatrix full = hinge_hessian(x, rest, kStiffness, false);
       const HingeMatrix solver = hinge_hessian(x, rest, kStiffness, true);
       EXPECT_GE(test::min_eigenvalue(solver), -1e-12 * full.norm());
-      const HingeMatrix dropped = 2 * kStiffness * rest.weight *
-                                  hinge_angle_deviation(x, rest) * dihedral_angle_hessian(x);
+      const HingeMatrix dropped =
+          2 * kStiffness * rest.weight * hinge_angle_deviation(x, rest) * dihedral_angle_hessian(x);
       EXPECT_LT(relative_error(solver + dropped, full), 1e-10);
       if (test::min_eigenvalue(full) < -1e-12 * full.norm()) ++indefinite;
     }
@@ -119,17 +121,6 @@ TEST(HingeEnergy, DegenerateStateHasInfiniteEnergyAndNoDerivatives) {
 
 // ---------------------------------------------------------------------------------------------
 // Whole meshes.
-
-struct CurvedShell {
-  TriMesh rest;
-  MeshTopology topology;
-};
-
-CurvedShell curved_shell(int cells, std::mt19937& rng) {
-  CurvedShell s{test::curved_sheet(cells, 0.3, rng), {}};
-  s.topology = MeshTopology::build(s.rest);
-  return s;
-}
 
 TEST(BendingEnergy, CurvedRestStateHasZeroEnergyAndGradient) {
   std::mt19937 rng(7);

@@ -1,16 +1,18 @@
 #pragma once
-// Meshes, states and matrix helpers shared by the elastic tests.
+// Meshes, states and matrix helpers shared by the elastic tests (dense_hessian comes from
+// support/derivative_check.hpp).
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
-#include "engine/core/element_matrices.hpp"
 #include "engine/elastic/dihedral_angle.hpp"
 #include "engine/elastic/material.hpp"
 #include "engine/mesh/generators.hpp"
+#include "engine/mesh/topology.hpp"
 #include "engine/mesh/tri_mesh.hpp"
+#include "support/derivative_check.hpp"
 
 namespace psq::test {
 
@@ -53,6 +55,18 @@ inline TriMesh curved_sheet(int cells, double jitter, std::mt19937& rng) {
   return mesh;
 }
 
+/// A curved_sheet (jitter 0.3) with its topology, for the bending energies.
+struct CurvedShell {
+  TriMesh rest;
+  MeshTopology topology;
+};
+
+inline CurvedShell curved_shell(int cells, std::mt19937& rng) {
+  CurvedShell s{curved_sheet(cells, 0.3, rng), {}};
+  s.topology = MeshTopology::build(s.rest);
+  return s;
+}
+
 /// x plus independent uniform noise in [−amplitude, amplitude] on every coordinate.
 inline Eigen::VectorXd randomly_perturbed(const Eigen::VectorXd& x, double amplitude,
                                           std::mt19937& rng) {
@@ -91,18 +105,6 @@ inline HingePositions folded_hinge(double fold, std::mt19937& rng) {
 
 /// Fold angles from nearly flat to strongly folded, of both signs.
 inline constexpr double kFolds[] = {-3.0, -1.2, -1e-4, 0.0, 1e-4, 0.7, 3.0};
-
-/// Sums element blocks into a dense dofs×dofs matrix.
-inline Eigen::MatrixXd dense_hessian(const ElementMatrices& blocks, Eigen::Index dofs) {
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(dofs, dofs);
-  const int s = blocks.stencil_size;
-  for (std::size_t e = 0; e < blocks.element_count(); ++e)
-    for (int a = 0; a < s; ++a)
-      for (int b = 0; b < s; ++b)
-        h.block<3, 3>(3 * blocks.vertices[e * s + a], 3 * blocks.vertices[e * s + b]) +=
-            blocks.block(e).block<3, 3>(3 * a, 3 * b);
-  return h;
-}
 
 /// Smallest eigenvalue of a symmetric matrix.
 inline double min_eigenvalue(const Eigen::MatrixXd& symmetric) {

@@ -16,6 +16,8 @@
 namespace psq {
 namespace {
 
+using test::curved_shell;
+using test::CurvedShell;
 using test::fd_gradient;
 using test::fd_jacobian;
 using test::relative_error;
@@ -330,17 +332,6 @@ TEST(MidedgeElement, DegenerateStateHasInfiniteEnergyAndNoDerivatives) {
 
 // ---------------------------------------------------------------------------------------------
 // Whole meshes.
-
-struct CurvedShell {
-  TriMesh rest;
-  MeshTopology topology;
-};
-
-CurvedShell curved_shell(int cells, std::mt19937& rng) {
-  CurvedShell s{test::curved_sheet(cells, 0.3, rng), {}};
-  s.topology = MeshTopology::build(s.rest);
-  return s;
-}
 
 Eigen::VectorXd energy_gradient(const MidedgeBendingEnergy& energy, const Eigen::VectorXd& x) {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
