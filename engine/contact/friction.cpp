@@ -109,6 +109,11 @@ StencilPositions FrictionPotential::displacement(const Eigen::VectorXd& x, std::
   return gather_stencil(x, vertices) - gather_stencil(step_start_, vertices);
 }
 
+StencilDerivatives<12> FrictionPotential::contact_derivatives(const Eigen::VectorXd& x,
+                                                              std::size_t c) const {
+  return friction_dissipation_derivatives(contacts_[c], displacement(x, c), slip_threshold_);
+}
+
 void FrictionPotential::check(const Eigen::VectorXd& x) const {
   if (x.size() != step_start_.size())
     throw std::invalid_argument("friction: position vector and step start differ in size");
@@ -125,23 +130,13 @@ double FrictionPotential::value(const Eigen::VectorXd& x) const {
 void FrictionPotential::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const {
   check(x);
   add_element_gradients<4>(
-      stencils_,
-      [&](std::size_t c) {
-        return friction_dissipation_derivatives(contacts_[c], displacement(x, c), slip_threshold_)
-            .gradient;
-      },
-      g);
+      stencils_, [&](std::size_t c) { return contact_derivatives(x, c).gradient; }, g);
 }
 
 void FrictionPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& out) const {
   check(x);
   fill_element_hessians<4>(
-      stencils_,
-      [&](std::size_t c) {
-        return friction_dissipation_derivatives(contacts_[c], displacement(x, c), slip_threshold_)
-            .hessian;
-      },
-      out);
+      stencils_, [&](std::size_t c) { return contact_derivatives(x, c).hessian; }, out);
 }
 
 }  // namespace psq

@@ -91,6 +91,9 @@ class FrictionPotential {
 
  private:
   [[nodiscard]] StencilPositions displacement(const Eigen::VectorXd& x, std::size_t c) const;
+  /// friction_dissipation_derivatives of contact c at x.
+  [[nodiscard]] StencilDerivatives<12> contact_derivatives(const Eigen::VectorXd& x,
+                                                           std::size_t c) const;
   void check(const Eigen::VectorXd& x) const;
 
   std::vector<LaggedFrictionContact> contacts_;

@@ -1,14 +1,33 @@
 #include "engine/contact/point_edge_distance.hpp"
 
+#include <array>
+
 namespace psq {
 namespace {
 
-/// The foot of p on the line through e0 and e1: its parameter α along e = e1 − e0 and the
-/// vector q = p − (e0 + α e) from the foot to p.
-struct LineFoot {
-  double alpha;
-  Eigen::Vector3d q;
-};
+/// point_feature's table for PointTriangleCase (Vertex0 … Edge20): three vertices, then three
+/// edges.
+constexpr std::array<PointFeature, 6> kPointTriangleSubCases{{{0, 1, {1, 0}},
+                                                              {0, 1, {2, 0}},
+                                                              {0, 1, {3, 0}},
+                                                              {0, 2, {1, 2}},
+                                                              {0, 2, {2, 3}},
+                                                              {0, 2, {3, 1}}}};
+static_assert(static_cast<int>(PointTriangleCase::Face) == kPointTriangleSubCases.size());
+
+/// point_feature's table for EdgeEdgeCase (A0B0 … B1EdgeA): four endpoint pairs, then four
+/// endpoint–edge pairs.
+constexpr std::array<PointFeature, 8> kEdgeEdgeSubCases{{{0, 1, {2, 0}},
+                                                         {0, 1, {3, 0}},
+                                                         {1, 1, {2, 0}},
+                                                         {1, 1, {3, 0}},
+                                                         {0, 2, {2, 3}},
+                                                         {1, 2, {2, 3}},
+                                                         {2, 2, {0, 1}},
+                                                         {3, 2, {0, 1}}}};
+static_assert(static_cast<int>(EdgeEdgeCase::LineLine) == kEdgeEdgeSubCases.size());
+
+}  // namespace
 
 LineFoot line_foot(const Eigen::Vector3d& p, const Eigen::Vector3d& e0, const Eigen::Vector3d& e1) {
   const Eigen::Vector3d e = e1 - e0;
@@ -16,8 +35,6 @@ LineFoot line_foot(const Eigen::Vector3d& p, const Eigen::Vector3d& e0, const Ei
   const double alpha = r.dot(e) / e.squaredNorm();
   return {alpha, r - alpha * e};
 }
-
-}  // namespace
 
 double point_point_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
   return (p - q).squaredNorm();
@@ -51,9 +68,12 @@ StencilDerivatives<9> point_line_distance_derivatives(const Eigen::Vector3d& p,
 double point_edge_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
                            const Eigen::Vector3d& e1) {
   switch (point_edge_case(p, e0, e1)) {
-    case PointEdgeCase::Vertex0: return point_point_distance(p, e0);
-    case PointEdgeCase::Vertex1: return point_point_distance(p, e1);
-    case PointEdgeCase::Line: break;
+    case PointEdgeCase::Vertex0:
+      return point_point_distance(p, e0);
+    case PointEdgeCase::Vertex1:
+      return point_point_distance(p, e1);
+    case PointEdgeCase::Line:
+      break;
   }
   return point_line_distance(p, e0, e1);
 }
@@ -66,9 +86,18 @@ StencilDerivatives<9> point_edge_distance_derivatives(const Eigen::Vector3d& p,
       return embed_in_stencil<3, 2>(point_point_distance_derivatives(p, e0), {0, 1});
     case PointEdgeCase::Vertex1:
       return embed_in_stencil<3, 2>(point_point_distance_derivatives(p, e1), {0, 2});
-    case PointEdgeCase::Line: break;
+    case PointEdgeCase::Line:
+      break;
   }
   return point_line_distance_derivatives(p, e0, e1);
+}
+
+const PointFeature& point_feature(PointTriangleCase boundary_case) {
+  return kPointTriangleSubCases[static_cast<int>(boundary_case)];
+}
+
+const PointFeature& point_feature(EdgeEdgeCase boundary_case) {
+  return kEdgeEdgeSubCases[static_cast<int>(boundary_case)];
 }
 
 double point_feature_distance(const PointFeature& sub_case, const StencilPositions& x) {

@@ -77,6 +77,17 @@ double point_point_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& q);
 StencilDerivatives<6> point_point_distance_derivatives(const Eigen::Vector3d& p,
                                                        const Eigen::Vector3d& q);
 
+/// The foot of p on the line through e0 and e1: its parameter α = (p − e0)·e/‖e‖² along
+/// e = e1 − e0 and the vector q = p − (e0 + α e) from the foot to p. The edge must have nonzero
+/// length.
+struct LineFoot {
+  double alpha;
+  Eigen::Vector3d q;
+};
+
+/// The foot of p on the line through e0 and e1.
+LineFoot line_foot(const Eigen::Vector3d& p, const Eigen::Vector3d& e0, const Eigen::Vector3d& e1);
+
 /// Squared distance from p to the LINE through e0 and e1: d = ‖p − e0 − α e‖² with
 /// e = e1 − e0 and α = (p − e0)·e/‖e‖². The edge must have nonzero length.
 double point_line_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
@@ -112,6 +123,15 @@ inline StencilPositions stack_stencil(const Eigen::Vector3d& a, const Eigen::Vec
   return x;
 }
 
+/// The closest points a and b of the two features of a 4-vertex stencil's interior case (a
+/// point and a plane, or two lines). They are found through the features' common normal rather
+/// than a Gram-matrix solve, which keeps q accurate when the features nearly touch.
+struct ClosestPair {
+  Eigen::Vector4d weights;  ///< w with Σ wᵢ xᵢ = a − b: affine weights of a, minus those of b
+  Eigen::Vector3d normal;   ///< the common normal of the features (not normalized)
+  Eigen::Vector3d q;        ///< a − b, computed along the normal
+};
+
 /// A point–point or point–edge sub-case of a 4-vertex stencil: the stencil vertex that is the
 /// point, and the one stencil vertex (feature_size 1) or the two edge endpoints (feature_size
 /// 2, measured to the edge's line) it is measured to.
@@ -120,6 +140,14 @@ struct PointFeature {
   int feature_size;
   std::array<int, 2> feature;
 };
+
+/// The point–point or point–edge sub-case of a point–triangle boundary case (any case but
+/// Face), in the stencil slots (p, t0, t1, t2) = (0, 1, 2, 3).
+const PointFeature& point_feature(PointTriangleCase boundary_case);
+
+/// The point–point or point–edge sub-case of an edge–edge boundary case (any case but
+/// LineLine), in the stencil slots (ea0, ea1, eb0, eb1) = (0, 1, 2, 3).
+const PointFeature& point_feature(EdgeEdgeCase boundary_case);
 
 /// The squared distance of a point–point or point–edge sub-case of a stencil.
 double point_feature_distance(const PointFeature& sub_case, const StencilPositions& x);

@@ -1,20 +1,21 @@
 // Additive CCD and its distance routines, checked against exact references (CGAL's exact
 // kernel), motions whose answers follow by hand, and the shared CCD benchmark set.
 
-#include <gtest/gtest.h>
+#include "engine/contact/additive_ccd.hpp"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 
-#include "engine/contact/additive_ccd.hpp"
+#include "engine/contact/ccd_query_file.hpp"
 #include "engine/contact/edge_edge_distance.hpp"
 #include "engine/contact/point_triangle_distance.hpp"
-#include "engine/contact/ccd_query_file.hpp"
 #include "engine/core/error.hpp"
+#include "support/random_geometry.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -60,10 +61,9 @@ double segment_segment(const PairPositions& x) {
 
 TEST(CcdDistance, PointTriangleMatchesExactDistanceOnRandomPairs) {
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
   for (int trial = 0; trial < 2000; ++trial) {
     PairPositions x;
-    for (Vector3d& v : x) v = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    for (Vector3d& v : x) v = test::random_point(rng);
     if (trial % 4 == 0)  // all in one plane, the point often inside the triangle
       for (Vector3d& v : x) v.z() = 0;
     EXPECT_NEAR(point_triangle(x), reference_distance(CcdQueryKind::vertex_face, x), 1e-12)
@@ -83,10 +83,9 @@ TEST(CcdDistance, PointTriangleRegionsByHand) {
 
 TEST(CcdDistance, SegmentSegmentMatchesExactDistanceOnRandomPairs) {
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
   for (int trial = 0; trial < 2000; ++trial) {
     PairPositions x;
-    for (Vector3d& v : x) v = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    for (Vector3d& v : x) v = test::random_point(rng);
     if (trial % 4 == 1) x[3] = x[2] + 0.7 * (x[1] - x[0]);  // exactly parallel directions
     EXPECT_NEAR(segment_segment(x), reference_distance(CcdQueryKind::edge_edge, x), 1e-12) << trial;
   }

@@ -10,16 +10,13 @@
 #include "engine/contact/edge_edge_distance.hpp"
 #include "engine/contact/point_triangle_distance.hpp"
 #include "engine/core/error.hpp"
-#include "support/finite_difference.hpp"
+#include "support/derivative_check.hpp"
+#include "support/random_geometry.hpp"
 
 namespace psq {
 namespace {
 
-using Eigen::Vector3d;
 using Eigen::VectorXd;
-using test::fd_gradient;
-using test::fd_jacobian;
-using test::relative_error;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
@@ -111,13 +108,10 @@ using StencilDistance = std::function<StencilDerivatives<12>(const VectorXd&)>;
 void expect_composite_matches_finite_differences(const StencilDistance& distance, const VectorXd& x,
                                                  const BarrierBand& band) {
   const auto composite = [&](const VectorXd& y) { return barrier_of_distance(distance(y), band); };
-  const StencilDerivatives<12> at_x = composite(x);
-  ASSERT_GT(at_x.value, 0);
-  const VectorXd fd_g = fd_gradient([&](const VectorXd& y) { return composite(y).value; }, x, 1e-6);
-  const Eigen::MatrixXd fd_h =
-      fd_jacobian([&](const VectorXd& y) -> VectorXd { return composite(y).gradient; }, x, 1e-6);
-  EXPECT_LT(relative_error(at_x.gradient, fd_g), 1e-6);
-  EXPECT_LT(relative_error(at_x.hessian, fd_h), 1e-6);
+  ASSERT_GT(composite(x).value, 0);
+  const test::DerivativeErrors errors = test::derivative_errors(composite, x, 1e-6);
+  EXPECT_LT(errors.gradient, 1e-6);
+  EXPECT_LT(errors.hessian, 1e-6);
 }
 
 TEST(BarrierOfDistance, MatchesFiniteDifferencesOnRandomPointTriangleAndEdgeEdgePairs) {
@@ -130,10 +124,8 @@ TEST(BarrierOfDistance, MatchesFiniteDifferencesOnRandomPointTriangleAndEdgeEdge
                                           x.segment<3>(9));
   };
   std::mt19937 rng(31);
-  std::uniform_real_distribution<> uniform(-1, 1);
   for (int trial = 0; trial < 20; ++trial) {
-    VectorXd x(12);
-    for (int i = 0; i < 12; ++i) x[i] = uniform(rng);
+    const VectorXd x = test::random_stencil(rng).reshaped();
     for (const StencilDistance& distance : {point_triangle, edge_edge}) {
       // A band around the pair's distance: thickness 0.3 of it, reach twice it.
       const double gap = std::sqrt(distance(x).value);

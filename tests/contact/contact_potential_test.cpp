@@ -13,6 +13,7 @@
 #include "engine/core/error.hpp"
 #include "engine/mesh/generators.hpp"
 #include "engine/mesh/topology.hpp"
+#include "support/derivative_check.hpp"
 #include "support/finite_difference.hpp"
 
 namespace psq {
@@ -102,12 +103,7 @@ TEST(ContactPotential, GradientAndHessianMatchFiniteDifferences) {
 
   ElementMatrices blocks;
   contact.hessian(sheets.x, blocks, false);
-  Eigen::MatrixXd hessian = Eigen::MatrixXd::Zero(sheets.x.size(), sheets.x.size());
-  for (std::size_t e = 0; e < blocks.element_count(); ++e)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        hessian.block<3, 3>(3 * blocks.vertices[4 * e + a], 3 * blocks.vertices[4 * e + b]) +=
-            blocks.block(e).block<3, 3>(3 * a, 3 * b);
+  const Eigen::MatrixXd hessian = test::dense_hessian(blocks, sheets.x.size());
   const Eigen::MatrixXd fd = test::fd_jacobian(
       [&](const Eigen::VectorXd& y) {
         Eigen::VectorXd gy = Eigen::VectorXd::Zero(y.size());

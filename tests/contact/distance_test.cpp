@@ -11,16 +11,14 @@
 #include "engine/contact/edge_edge_distance.hpp"
 #include "engine/contact/point_edge_distance.hpp"
 #include "engine/contact/point_triangle_distance.hpp"
-#include "support/finite_difference.hpp"
+#include "support/derivative_check.hpp"
+#include "support/random_geometry.hpp"
 
 namespace psq {
 namespace {
 
 using Eigen::Vector3d;
 using Eigen::VectorXd;
-using test::fd_gradient;
-using test::fd_jacobian;
-using test::relative_error;
 
 using Stencil = std::array<Vector3d, 4>;
 
@@ -54,12 +52,10 @@ template <int Dofs>
 void expect_derivatives_match_finite_differences(
     const std::function<StencilDerivatives<Dofs>(const VectorXd&)>& f, const VectorXd& x, double h,
     double tolerance) {
+  const test::DerivativeErrors errors = test::derivative_errors(f, x, h);
+  EXPECT_LT(errors.gradient, tolerance) << "gradient at " << x.transpose();
+  EXPECT_LT(errors.hessian, tolerance) << "Hessian at " << x.transpose();
   const StencilDerivatives<Dofs> at_x = f(x);
-  const VectorXd fd_g = fd_gradient([&](const VectorXd& y) { return f(y).value; }, x, h);
-  EXPECT_LT(relative_error(at_x.gradient, fd_g), tolerance) << "gradient at " << x.transpose();
-  const Eigen::MatrixXd fd_h =
-      fd_jacobian([&](const VectorXd& y) -> VectorXd { return f(y).gradient; }, x, h);
-  EXPECT_LT(relative_error(at_x.hessian, fd_h), tolerance) << "Hessian at " << x.transpose();
   EXPECT_LT((at_x.hessian - at_x.hessian.transpose()).norm(), 1e-12 * at_x.hessian.norm());
 }
 
@@ -126,7 +122,7 @@ struct Rng {
   std::mt19937 engine;
   explicit Rng(unsigned seed) : engine(seed) {}
   double uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(engine); }
-  Vector3d point() { return {uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)}; }
+  Vector3d point() { return test::random_point(engine); }
   Vector3d unit() {
     for (;;) {
       const Vector3d v = point();

@@ -15,7 +15,9 @@
 #include "engine/contact/point_triangle_distance.hpp"
 #include "engine/contact/tangent_basis.hpp"
 #include "engine/core/error.hpp"
+#include "support/derivative_check.hpp"
 #include "support/finite_difference.hpp"
+#include "support/random_geometry.hpp"
 
 namespace psq {
 namespace {
@@ -175,22 +177,9 @@ LaggedFrictionContact lagged(const Stencil& s, double friction = kFriction) {
 /// every vertex, rescaled.
 VectorXd motion_with_slip(const LaggedFrictionContact& contact, double slip, unsigned seed) {
   std::mt19937 random(seed);
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  StencilPositions motion;
-  for (int i = 0; i < 12; ++i) motion.data()[i] = uniform(random);
+  const StencilPositions motion = test::random_stencil(random);
   const double y = tangential_displacement(contact.frame, motion).norm();
   return flatten(motion) * (slip * kSlip / y);
-}
-
-Eigen::MatrixXd dense(const ElementMatrices& blocks, int dofs) {
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(dofs, dofs);
-  const int n = blocks.stencil_size;
-  for (std::size_t e = 0; e < blocks.element_count(); ++e)
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b)
-        h.block<3, 3>(3 * blocks.vertices[e * n + a], 3 * blocks.vertices[e * n + b]) +=
-            blocks.block(e).block<3, 3>(3 * a, 3 * b);
-  return h;
 }
 
 TEST(FrictionPotential, DerivativesMatchFiniteDifferencesInEverySubCaseOnBothBranches) {
@@ -211,7 +200,7 @@ TEST(FrictionPotential, DerivativesMatchFiniteDifferencesInEverySubCaseOnBothBra
       EXPECT_LT(relative_error(gradient(x), fd_gradient(value, x, h)), 1e-6);
       ElementMatrices blocks;
       friction.hessian(x, blocks);
-      const Eigen::MatrixXd hessian = dense(blocks, 12);
+      const Eigen::MatrixXd hessian = test::dense_hessian(blocks, 12);
       EXPECT_LT(relative_error(hessian, fd_jacobian(gradient, x, h)), 1e-6);
       EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(hessian).eigenvalues().minCoeff(),
                 -1e-9 * hessian.norm());

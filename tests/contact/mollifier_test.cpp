@@ -1,21 +1,18 @@
-#include "engine/contact/edge_edge_mollifier.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
-#include "support/finite_difference.hpp"
+#include "engine/contact/edge_edge_mollifier.hpp"
+#include "support/derivative_check.hpp"
+#include "support/random_geometry.hpp"
 
 namespace psq {
 namespace {
 
 using Eigen::Vector3d;
 using Eigen::VectorXd;
-using test::fd_gradient;
-using test::fd_jacobian;
-using test::relative_error;
 
 StencilDerivatives<12> cross_norm_of(const VectorXd& x) {
   return edge_edge_cross_squared_norm(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6),
@@ -24,12 +21,11 @@ StencilDerivatives<12> cross_norm_of(const VectorXd& x) {
 
 /// Edges of lengths la and lb at angle θ, in a generic position.
 VectorXd edges_at_angle(double theta, double la, double lb, std::mt19937& rng) {
-  std::uniform_real_distribution<> uniform(-1, 1);
-  const Vector3d u = Vector3d(uniform(rng), uniform(rng), uniform(rng)).normalized();
-  const Vector3d w = u.cross(Vector3d(uniform(rng), uniform(rng), uniform(rng))).normalized();
+  const Vector3d u = test::random_point(rng).normalized();
+  const Vector3d w = u.cross(test::random_point(rng)).normalized();
   const Vector3d v = std::cos(theta) * u + std::sin(theta) * w;
-  const Vector3d ea0(uniform(rng), uniform(rng), uniform(rng));
-  const Vector3d eb0(uniform(rng), uniform(rng), uniform(rng));
+  const Vector3d ea0 = test::random_point(rng);
+  const Vector3d eb0 = test::random_point(rng);
   VectorXd x(12);
   x << ea0, ea0 + la * u, eb0, eb0 + lb * v;
   return x;
@@ -87,13 +83,9 @@ TEST(EdgeEdgeMollifier, CrossNormDerivativesMatchFiniteDifferences) {
   std::mt19937 rng(4);
   for (double theta : {1e-3, 0.4, 1.2}) {
     const VectorXd x = edges_at_angle(theta, 1.1, 0.8, rng);
-    const StencilDerivatives<12> c = cross_norm_of(x);
-    const VectorXd fd_g =
-        fd_gradient([](const VectorXd& y) { return cross_norm_of(y).value; }, x, 1e-6);
-    const Eigen::MatrixXd fd_h = fd_jacobian(
-        [](const VectorXd& y) -> VectorXd { return cross_norm_of(y).gradient; }, x, 1e-6);
-    EXPECT_LT(relative_error(c.gradient, fd_g), 1e-7) << "θ = " << theta;
-    EXPECT_LT(relative_error(c.hessian, fd_h), 1e-7) << "θ = " << theta;
+    const test::DerivativeErrors errors = test::derivative_errors(cross_norm_of, x, 1e-6);
+    EXPECT_LT(errors.gradient, 1e-7) << "θ = " << theta;
+    EXPECT_LT(errors.hessian, 1e-7) << "θ = " << theta;
   }
 }
 
@@ -110,12 +102,9 @@ TEST(EdgeEdgeMollifier, MollifierOfTheStencilMatchesFiniteDifferencesBelowTheThr
     const StencilDerivatives<12> m = mollifier(x);
     ASSERT_LT(m.value, 1);
     ASSERT_GT(m.value, 0);
-    const VectorXd fd_g =
-        fd_gradient([&](const VectorXd& y) { return mollifier(y).value; }, x, 1e-7);
-    const Eigen::MatrixXd fd_h =
-        fd_jacobian([&](const VectorXd& y) -> VectorXd { return mollifier(y).gradient; }, x, 1e-7);
-    EXPECT_LT(relative_error(m.gradient, fd_g), 1e-6) << "θ = " << theta;
-    EXPECT_LT(relative_error(m.hessian, fd_h), 1e-6) << "θ = " << theta;
+    const test::DerivativeErrors errors = test::derivative_errors(mollifier, x, 1e-7);
+    EXPECT_LT(errors.gradient, 1e-6) << "θ = " << theta;
+    EXPECT_LT(errors.hessian, 1e-6) << "θ = " << theta;
   }
 }
 

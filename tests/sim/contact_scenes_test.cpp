@@ -49,7 +49,10 @@ long most_active_pairs(const SceneRun& run) {
   return most;
 }
 
-void expect_converged(const SceneRun& run) {
+/// Every stored frame passed the intersection check and every frame's Newton solve converged.
+void expect_intersection_free_and_converged(const SceneRun& run) {
+  EXPECT_TRUE(run.intersecting_frames.empty())
+      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
   for (const FrameRecord& f : run.frames) EXPECT_TRUE(f.newton.converged) << "frame " << f.frame;
 }
 
@@ -60,9 +63,7 @@ TEST(ContactScenes, DrapeOverSphereSkipsTheFreeFallAndStaysIntersectionFree) {
   set_edge_length(scene.colliders[0].mesh, 0.1);
   scene.time.frames = 6;
   const SceneRun run = simulate(scene);
-  EXPECT_TRUE(run.intersecting_frames.empty())
-      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
-  expect_converged(run);
+  expect_intersection_free_and_converged(run);
   // The cloth starts 5 cm above the ball and falls Δt² g ≈ 1.6 cm per frame: the first frames
   // have nothing within reach, every evaluation skips the barrier and every step the CCD.
   const ContactStats& first = run.frames.front().contact;
@@ -83,9 +84,7 @@ TEST(ContactScenes, TwistedSheetStaysIntersectionFree) {
   set_edge_length(scene.shells[0].mesh, 0.1);
   scene.time.frames = 14;  // 210° per end: the layers first touch around frame 9
   const SceneRun run = simulate(scene);
-  EXPECT_TRUE(run.intersecting_frames.empty())
-      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
-  expect_converged(run);
+  expect_intersection_free_and_converged(run);
   EXPECT_GT(most_active_pairs(run), 0);  // the sheet wraps onto itself
 }
 
@@ -95,9 +94,7 @@ TEST(ContactScenes, CrushedCylinderStaysIntersectionFree) {
   set_edge_length(scene.colliders[0].mesh, 0.08);
   scene.time.frames = 4;  // the plate meets the rim in frame 2 and pushes it 2 mm down
   const SceneRun run = simulate(scene);
-  EXPECT_TRUE(run.intersecting_frames.empty())
-      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
-  expect_converged(run);
+  expect_intersection_free_and_converged(run);
   EXPECT_GT(most_active_pairs(run), 0);  // the plate reaches the rim
 }
 
@@ -106,9 +103,7 @@ TEST(ContactScenes, BunnyPressStaysIntersectionFree) {
   set_edge_length(scene.shells[0].mesh, 0.05);
   scene.time.frames = 7;  // the bunny comes down 4 mm per frame and meets the sheet in frame 5
   const SceneRun run = simulate(scene);
-  EXPECT_TRUE(run.intersecting_frames.empty())
-      << fmt::format("{}", fmt::join(run.intersecting_frames, "\n"));
-  expect_converged(run);
+  expect_intersection_free_and_converged(run);
   EXPECT_GT(most_active_pairs(run), 0);  // the bunny reaches the sheet
 }
 
