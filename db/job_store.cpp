@@ -2,13 +2,13 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <sqlite3.h>
 
 #include <chrono>
-#include <sqlite3.h>
-#include <thread>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 
 #include "db/schema.hpp"
 
@@ -98,8 +98,8 @@ LevelRecord read_level(const Statement& row, int first) {
                                                    : std::numeric_limits<double>::quiet_NaN());
   const auto timings = nlohmann::json::parse(row.text(first + 4));
   for (const auto& [phase, seconds] : timings.items())
-    level.timings[phase] = seconds.is_number() ? seconds.get<double>()
-                                               : std::numeric_limits<double>::quiet_NaN();
+    level.timings[phase] =
+        seconds.is_number() ? seconds.get<double>() : std::numeric_limits<double>::quiet_NaN();
   level.checkpoint_path = row.text(first + 5);
   level.checkpoint_checksum = row.text(first + 6);
   level.error = row.text(first + 7);
@@ -138,8 +138,8 @@ void validate_new_job(const std::string& sweep, const NewJob& job) {
     throw InputError(fmt::format("sweep '{}': job {}: {}", sweep, job.id, problem));
   };
   if (job.id.empty()) fail("empty job id (ids are hashes of the canonical parameters)");
-  if (job.depth < 1) fail(fmt::format("depth {} is not a number of levels; use 1 or more",
-                                      job.depth));
+  if (job.depth < 1)
+    fail(fmt::format("depth {} is not a number of levels; use 1 or more", job.depth));
   if (job.max_attempts < 1)
     fail(fmt::format("max attempts {} must be at least 1", job.max_attempts));
 }
@@ -155,8 +155,7 @@ JobStore::JobStore(const std::filesystem::path& path, JobStoreOptions options)
 
 double JobStore::now() const {
   if (options_.clock) return options_.clock();
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 SweepAddition JobStore::add_sweep(const std::string& name, const std::string& source,
@@ -187,8 +186,8 @@ SweepAddition JobStore::add_jobs(const std::string& name, const std::string& sou
   auto insert = connection_.prepare(
       "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at) "
       "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
-  auto link = connection_.prepare(
-      "INSERT OR IGNORE INTO sweep_jobs (sweep_id, job_id) VALUES (?1, ?2)");
+  auto link =
+      connection_.prepare("INSERT OR IGNORE INTO sweep_jobs (sweep_id, job_id) VALUES (?1, ?2)");
   SweepAddition addition;
   for (const auto& job : jobs) {
     const std::string parameters = job.parameters.dump();
@@ -243,9 +242,8 @@ std::optional<Claim> JobStore::claim_next(const WorkerInfo& worker, double lease
   expire_leases(time);
   std::string id;
   {
-    auto next = connection_.prepare(
-        "SELECT id FROM jobs WHERE state = 'queued' AND " + selection_condition(which) +
-        " ORDER BY number LIMIT 1");
+    auto next = connection_.prepare("SELECT id FROM jobs WHERE state = 'queued' AND " +
+                                    selection_condition(which) + " ORDER BY number LIMIT 1");
     if (!next.bind_all(selection_value(which)).step()) {
       next.reset();
       transaction.commit();
@@ -281,8 +279,8 @@ bool JobStore::heartbeat(const Lease& lease) {
 int JobStore::check_lease(const Lease& lease) {
   auto job = connection_.prepare("SELECT state, attempt, depth FROM jobs WHERE id = ?1");
   if (!job.bind_all(lease.job_id).step())
-    throw LeaseLostError(fmt::format("job {} is not in {}; the write was refused", lease.job_id,
-                                     path().string()));
+    throw LeaseLostError(
+        fmt::format("job {} is not in {}; the write was refused", lease.job_id, path().string()));
   if (job.text(0) != to_string(JobState::running) || job.integer(1) != lease.attempt)
     throw LeaseLostError(fmt::format(
         "job {}: attempt {} no longer holds the lease (the job is {} at attempt {}); the write "
@@ -295,8 +293,8 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
   Transaction transaction(connection_, Transaction::Mode::immediate);
   const int depth = check_lease(lease);
   if (level.level < 0 || level.level >= depth)
-    throw std::invalid_argument(fmt::format("job {}: level {} outside [0, {})", lease.job_id,
-                                            level.level, depth));
+    throw std::invalid_argument(
+        fmt::format("job {}: level {} outside [0, {})", lease.job_id, level.level, depth));
   nlohmann::json timings = nlohmann::json::object();
   for (const auto& [phase, seconds] : level.timings) timings[phase] = seconds;
   connection_
@@ -361,46 +359,36 @@ void JobStore::check_selection_exists(const JobSelection& which) {
                                which.name(), fmt::join(names, ", ")));
 }
 
-std::int64_t JobStore::cancel(const JobSelection& which) {
+std::int64_t JobStore::update_selected(const JobSelection& which, const std::string& update) {
   Transaction transaction(connection_, Transaction::Mode::immediate);
   check_selection_exists(which);
-  const auto cancelled =
-      connection_
-          .prepare("UPDATE jobs SET state = 'cancelled', lease_owner = NULL, lease_expiry = NULL, "
-                   "ended_at = ?2 WHERE state IN ('queued', 'running') AND " +
-                   selection_condition(which))
-          .bind_all(selection_value(which), now())
-          .run();
+  Statement statement = connection_.prepare(update + " AND " + selection_condition(which));
+  statement.bind(1, selection_value(which));
+  if (statement.parameter_count() >= 2) statement.bind(2, now());
+  const std::int64_t changed = statement.run();
   transaction.commit();
-  return cancelled;
+  return changed;
+}
+
+std::int64_t JobStore::cancel(const JobSelection& which) {
+  return update_selected(which,
+                         "UPDATE jobs SET state = 'cancelled', lease_owner = NULL, "
+                         "lease_expiry = NULL, ended_at = ?2 WHERE state IN ('queued', 'running')");
 }
 
 std::int64_t JobStore::requeue_interrupted(const JobSelection& which) {
-  Transaction transaction(connection_, Transaction::Mode::immediate);
-  check_selection_exists(which);
-  const auto requeued =
-      connection_
-          .prepare("UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
-                   "WHERE state = 'running' AND lease_expiry <= ?2 AND " +
-                   selection_condition(which))
-          .bind_all(selection_value(which), now())
-          .run();
-  transaction.commit();
-  return requeued;
+  return update_selected(
+      which,
+      "UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
+      "WHERE state = 'running' AND lease_expiry <= ?2");
 }
 
 std::int64_t JobStore::retry(const JobSelection& which, bool include_cancelled) {
-  Transaction transaction(connection_, Transaction::Mode::immediate);
-  check_selection_exists(which);
   const std::string states = include_cancelled ? "('failed', 'cancelled')" : "('failed')";
-  const auto requeued =
-      connection_
-          .prepare("UPDATE jobs SET state = 'queued', failures = 0, error = NULL, ended_at = NULL "
-                   "WHERE state IN " + states + " AND " + selection_condition(which))
-          .bind_all(selection_value(which))
-          .run();
-  transaction.commit();
-  return requeued;
+  return update_selected(which,
+                         "UPDATE jobs SET state = 'queued', failures = 0, error = NULL, "
+                         "ended_at = NULL WHERE state IN " +
+                             states);
 }
 
 std::vector<SweepStatus> JobStore::status() {
@@ -435,9 +423,10 @@ SweepStatus JobStore::status(const std::string& sweep) {
 }
 
 std::vector<Job> JobStore::jobs_where(const std::string& condition, const JobSelection& which) {
-  auto rows = connection_.prepare(fmt::format("SELECT {} FROM jobs WHERE {} AND ({}) ORDER BY "
-                                              "jobs.number",
-                                              kJobColumns, selection_condition(which), condition));
+  auto rows =
+      connection_.prepare(fmt::format("SELECT {} FROM jobs WHERE {} AND ({}) ORDER BY "
+                                      "jobs.number",
+                                      kJobColumns, selection_condition(which), condition));
   rows.bind_all(selection_value(which));
   std::vector<Job> jobs;
   while (rows.step()) jobs.push_back(read_job(rows));

@@ -112,6 +112,11 @@ class JobStore {
   int check_lease(const Lease& lease);
   /// Throws InputError if the selection names a sweep or job that is not stored.
   void check_selection_exists(const JobSelection& which);
+  /// In one immediate transaction, after check_selection_exists: runs `update` (an UPDATE of
+  /// `jobs` ending in a WHERE condition) on the selected jobs only. ?1 is the selection's value;
+  /// ?2, if `update` uses it, the current time, read inside the transaction. Returns the number
+  /// of jobs changed.
+  std::int64_t update_selected(const JobSelection& which, const std::string& update);
   std::vector<Job> jobs_where(const std::string& condition, const JobSelection& which);
   double now() const;
 

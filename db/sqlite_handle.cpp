@@ -41,12 +41,11 @@ namespace {
     case SQLITE_PERM:
     case SQLITE_AUTH:
       throw InputError(fmt::format(
-          "{}: the database cannot be written ({} while {}); check the file's permissions",
-          path, detail, what));
+          "{}: the database cannot be written ({} while {}); check the file's permissions", path,
+          detail, what));
     default:
-      throw DatabaseError(fmt::format("{}: {} failed: {} ({})", path, what, detail,
-                                      sqlite3_errstr(code)),
-                          code);
+      throw DatabaseError(
+          fmt::format("{}: {} failed: {} ({})", path, what, detail, sqlite3_errstr(code)), code);
   }
 }
 
@@ -80,8 +79,8 @@ void SqliteConnection::execute(std::string_view sql) {
 Statement SqliteConnection::prepare(std::string_view sql) {
   sqlite3_stmt* statement = nullptr;
   const char* tail = nullptr;
-  const int code = sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &statement,
-                                      &tail);
+  const int code =
+      sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &statement, &tail);
   if (code != SQLITE_OK) fail(code, running(sql));
   Statement prepared(*this, statement);
   if (std::string_view(tail, sql.data() + sql.size() - tail).find_first_not_of(" \t\n;") !=
@@ -121,6 +120,8 @@ Statement& Statement::bind(int index, std::int64_t value) {
     fail_on(*connection_, statement_, code);
   return *this;
 }
+
+int Statement::parameter_count() const { return sqlite3_bind_parameter_count(statement_); }
 
 Statement& Statement::bind(int index, double value) {
   if (const int code = sqlite3_bind_double(statement_, index, value); code != SQLITE_OK)

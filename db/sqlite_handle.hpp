@@ -87,6 +87,8 @@ class Statement {
   Statement& bind(int index, const std::optional<T>& value) {
     return value ? bind(index, *value) : bind(index, std::nullopt);
   }
+  /// The number of parameters: the largest parameter index the statement uses.
+  int parameter_count() const;
   /// Binds `values` to parameters 1, 2, ... in order.
   template <class... Values>
   Statement& bind_all(const Values&... values) {

@@ -4,11 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
-#include <iterator>
 
-#include "engine/io/checkpoint.hpp"
 #include "engine/core/checksum.hpp"
+#include "engine/io/checkpoint.hpp"
 #include "engine/io/xdmf.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "jobs/heartbeat.hpp"
@@ -78,11 +76,13 @@ Scene job_scene(const db::Job& job) {
   }
 }
 
-std::uint64_t file_checksum(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  const std::string bytes{std::istreambuf_iterator<char>(in), {}};
-  if (!in && !in.eof()) throw CheckpointError(fmt::format("cannot read '{}'", file.string()));
-  return fnv1a64(std::as_bytes(std::span(bytes)));
+/// The file checksum of a candidate that read_checkpoint has just verified: the recorded one it
+/// was verified against (no second read), else the file's own.
+std::uint64_t verified_checksum(const ResumeCandidate& candidate) {
+  if (candidate.recorded_checksum) return *candidate.recorded_checksum;
+  const std::optional<std::uint64_t> checksum = file_fnv1a64(candidate.file);
+  if (!checksum) throw CheckpointError(fmt::format("cannot read '{}'", candidate.file.string()));
+  return *checksum;
 }
 
 IterationRecord iteration_record(int frame, const NewtonIteration& it) {
@@ -184,7 +184,7 @@ class JobRun {
                          flat(checkpoint.solver.previous_positions),
                          in_frame ? checkpoint.solver.iterations_in_frame : 0);
         if (in_frame) resumed_in_frame_ = {checkpoint.frame, checkpoint.solver.iterations_in_frame};
-        continue_from(candidate.file, std::move(checkpoint));
+        continue_from(candidate, std::move(checkpoint));
         return;
       } catch (const std::invalid_argument& error) {
         log(fmt::format("{}: does not fit the job ({}); trying an earlier checkpoint",
@@ -196,15 +196,15 @@ class JobRun {
     start_level();
   }
 
-  void continue_from(const fs::path& file, Checkpoint checkpoint) {
+  void continue_from(const ResumeCandidate& candidate, Checkpoint checkpoint) {
     log(fmt::format("resuming level {} frame {} from {}", checkpoint.level, checkpoint.frame,
-                    file.filename().string()));
+                    candidate.file.filename().string()));
     for (int level = 0; level < checkpoint.level; ++level) add_sidecar_entry(level);
     statistics_ = std::move(checkpoint.statistics);
     level_start_ = Clock::now();
     since_checkpoint_ = Clock::now();
     if (checkpoint.solver.progress == LevelProgress::level_done)
-      record_finished_level(file, file_checksum(file));
+      record_finished_level(candidate.file, verified_checksum(candidate));
   }
 
   void start_level() {

@@ -2,20 +2,15 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
-#include <sstream>
-
-#include "engine/core/error.hpp"
 #include "engine/core/checksum.hpp"
+#include "engine/core/error.hpp"
 
 namespace psq::jobs {
 
 std::string file_content_hash(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(located_message(file.string(), 0, "cannot read the file"));
-  std::stringstream content;
-  content << in.rdbuf();
-  return fmt::format("fnv1a64:{:016x}", Fnv1a64().update(content.str()).value());
+  const std::optional<std::uint64_t> checksum = file_fnv1a64(file);
+  if (!checksum) throw InputError(located_message(file.string(), 0, "cannot read the file"));
+  return checksum_text(*checksum);
 }
 
 nlohmann::json canonical_parameters(const std::string& scene_hash, const Overrides& overrides,

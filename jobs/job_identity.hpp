@@ -15,7 +15,8 @@ namespace psq::jobs {
 /// real parameters are stored as doubles and integer ones as integers (see apply_overrides).
 using Overrides = std::map<std::string, nlohmann::json>;
 
-/// "fnv1a64:<16 hex digits>" of a file's bytes. Throws InputError if it cannot be read.
+/// checksum_text of a file's bytes: "fnv1a64:<16 hex digits>". Throws InputError if it cannot
+/// be read.
 std::string file_content_hash(const std::filesystem::path& file);
 
 /// The canonical parameters of a job:

@@ -2,18 +2,13 @@
 
 #include <fmt/format.h>
 
-#include <charconv>
-#include <string_view>
 #include <system_error>
 
+#include "engine/core/checksum.hpp"
 #include "engine/core/error.hpp"
 
 namespace psq::jobs {
 namespace fs = std::filesystem;
-
-namespace {
-constexpr std::string_view kChecksumPrefix = "fnv1a64:";
-}  // namespace
 
 fs::path RunDirectory::level_checkpoint(int level) const {
   return dir_ / fmt::format("level_{}.h5", level);
@@ -74,21 +69,6 @@ std::vector<ResumeCandidate> resume_candidates(const RunDirectory& run, int dept
     }
   }
   return candidates;
-}
-
-std::string checksum_text(std::uint64_t checksum) {
-  return fmt::format("{}{:016x}", kChecksumPrefix, checksum);
-}
-
-std::optional<std::uint64_t> parse_checksum(const std::string& text) {
-  if (!text.starts_with(kChecksumPrefix)) return std::nullopt;
-  const std::string_view digits = std::string_view(text).substr(kChecksumPrefix.size());
-  std::uint64_t value = 0;
-  const auto [end, error] =
-      std::from_chars(digits.data(), digits.data() + digits.size(), value, 16);
-  if (error != std::errc() || end != digits.data() + digits.size() || digits.size() != 16)
-    return std::nullopt;
-  return value;
 }
 
 }  // namespace psq::jobs

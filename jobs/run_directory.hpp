@@ -54,9 +54,4 @@ struct ResumeCandidate {
 std::vector<ResumeCandidate> resume_candidates(const RunDirectory& run, int depth,
                                                const std::vector<db::LevelRecord>& records);
 
-/// "fnv1a64:<16 hex digits>", the form the store records checkpoint checksums in.
-std::string checksum_text(std::uint64_t checksum);
-/// The value of checksum_text's form; nothing for any other text.
-std::optional<std::uint64_t> parse_checksum(const std::string& text);
-
 }  // namespace psq::jobs

@@ -24,48 +24,63 @@ struct Slot {
 bool positive(double x) { return x > 0; }
 bool at_least_one(double x) { return x >= 1; }
 
-/// The slots of the top-level parameters, by path.
+/// The slots of the top-level parameters, by path, in the order parameter_paths lists them.
+const std::vector<std::pair<std::string, Slot>>& scene_slots() {
+  static const std::vector<std::pair<std::string, Slot>> slots = {
+      {"time.step",
+       {false, positive, "positive",
+        [](Scene& s, const nlohmann::json& v) { s.time.step = v.get<double>(); }}},
+      {"time.frames",
+       {true, at_least_one, "at least 1",
+        [](Scene& s, const nlohmann::json& v) { s.time.frames = v.get<int>(); }}},
+      {"solver.tolerance",
+       {false, positive, "positive",
+        [](Scene& s, const nlohmann::json& v) { s.solver.tolerance = v.get<double>(); }}},
+      {"solver.max_iterations",
+       {true, at_least_one, "at least 1",
+        [](Scene& s, const nlohmann::json& v) { s.solver.max_iterations = v.get<int>(); }}},
+  };
+  return slots;
+}
+
 std::optional<Slot> scene_slot(const std::string& path) {
-  if (path == "time.step")
-    return Slot{false, positive, "positive",
-                [](Scene& s, const nlohmann::json& v) { s.time.step = v.get<double>(); }};
-  if (path == "time.frames")
-    return Slot{true, at_least_one, "at least 1",
-                [](Scene& s, const nlohmann::json& v) { s.time.frames = v.get<int>(); }};
-  if (path == "solver.tolerance")
-    return Slot{false, positive, "positive",
-                [](Scene& s, const nlohmann::json& v) { s.solver.tolerance = v.get<double>(); }};
-  if (path == "solver.max_iterations")
-    return Slot{true, at_least_one, "at least 1",
-                [](Scene& s, const nlohmann::json& v) { s.solver.max_iterations = v.get<int>(); }};
+  for (const auto& [slot_path, slot] : scene_slots())
+    if (slot_path == path) return slot;
   return std::nullopt;
 }
 
-const std::vector<std::string> kScenePaths = {"time.step", "time.frames", "solver.tolerance",
-                                              "solver.max_iterations"};
-const std::vector<std::string> kMaterialKeys = {"youngs_modulus", "poisson_ratio", "density",
-                                                "thickness"};
+/// A material parameter every shell has: "shell.<name>.material.<key>".
+struct MaterialKey {
+  std::string key;
+  double Material::*field;
+  std::function<bool(double)> valid;
+  std::string rule;  ///< completes "must be ..."
+};
+
+const std::vector<MaterialKey>& material_keys() {
+  static const std::vector<MaterialKey> keys = {
+      {"youngs_modulus", &Material::youngs_modulus, positive, "positive"},
+      {"poisson_ratio", &Material::poisson_ratio, [](double nu) { return nu > -1 && nu < 0.5; },
+       "in (-1, 0.5)"},
+      {"density", &Material::density, positive, "positive"},
+      {"thickness", &Material::thickness, positive, "positive"},
+  };
+  return keys;
+}
 
 /// The slot of "shell.<name>.material.<key>" (the shell name may contain dots).
 std::optional<Slot> material_slot(const Scene& scene, const std::string& path) {
-  const std::string prefix = "shell.";
-  if (path.rfind(prefix, 0) != 0) return std::nullopt;
   for (std::size_t index = 0; index < scene.shells.size(); ++index) {
-    const std::string shell_prefix = prefix + scene.shells[index].name + ".material.";
-    if (path.rfind(shell_prefix, 0) != 0) continue;
+    const std::string shell_prefix = "shell." + scene.shells[index].name + ".material.";
+    if (!path.starts_with(shell_prefix)) continue;
     const std::string key = path.substr(shell_prefix.size());
-    auto field = [index, key](Scene& s) -> double& {
-      Material& m = s.shells[index].material;
-      if (key == "youngs_modulus") return m.youngs_modulus;
-      if (key == "poisson_ratio") return m.poisson_ratio;
-      if (key == "density") return m.density;
-      return m.thickness;
-    };
-    auto set = [field](Scene& s, const nlohmann::json& v) { field(s) = v.get<double>(); };
-    if (key == "poisson_ratio")
-      return Slot{false, [](double nu) { return nu > -1 && nu < 0.5; }, "in (-1, 0.5)", set};
-    if (key == "youngs_modulus" || key == "density" || key == "thickness")
-      return Slot{false, positive, "positive", set};
+    for (const MaterialKey& material : material_keys()) {
+      if (material.key != key) continue;
+      const auto set = [index, field = material.field](Scene& s, const nlohmann::json& v) {
+        s.shells[index].material.*field = v.get<double>();
+      };
+      return Slot{false, material.valid, material.rule, set};
+    }
   }
   return std::nullopt;
 }
@@ -88,23 +103,22 @@ Slot find_slot(const Scene& scene, const std::string& path) {
 }  // namespace
 
 std::vector<std::string> parameter_paths(const Scene& scene) {
-  std::vector<std::string> paths = kScenePaths;
+  std::vector<std::string> paths;
+  for (const auto& [path, slot] : scene_slots()) paths.push_back(path);
   for (const Shell& shell : scene.shells)
-    for (const std::string& key : kMaterialKeys)
-      paths.push_back(fmt::format("shell.{}.material.{}", shell.name, key));
+    for (const MaterialKey& material : material_keys())
+      paths.push_back(fmt::format("shell.{}.material.{}", shell.name, material.key));
   return paths;
 }
 
-void check_parameter_path(const Scene& scene, const std::string& path) {
-  find_slot(scene, path);
-}
+void check_parameter_path(const Scene& scene, const std::string& path) { find_slot(scene, path); }
 
 nlohmann::json canonical_override(const Scene& scene, const std::string& path,
                                   const nlohmann::json& value) {
   const Slot slot = find_slot(scene, path);
   auto fail = [&](const std::string& requirement) -> OverrideError {
-    return OverrideError(path, fmt::format("parameter '{}' must be {} (got {})", path, requirement,
-                                           value.dump()));
+    return OverrideError(
+        path, fmt::format("parameter '{}' must be {} (got {})", path, requirement, value.dump()));
   };
   if (slot.integer) {
     if (!value.is_number_integer()) throw fail("an integer");

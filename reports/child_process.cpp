@@ -34,13 +34,6 @@ class FileActions {
   posix_spawn_file_actions_t actions_;
 };
 
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 }  // namespace
 
 ChildExit run_child(const std::string& program, const std::vector<std::string>& arguments,
@@ -66,8 +59,15 @@ ChildExit run_child(const std::string& program, const std::vector<std::string>& 
       throw InputError(fmt::format("cannot wait for '{}': {}", program, std::strerror(errno)));
   ChildExit exit;
   exit.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  exit.errors = read_text(error_file);
+  exit.errors = read_child_output(error_file);
   return exit;
+}
+
+std::string read_child_output(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 }  // namespace psq::reports

@@ -1,5 +1,6 @@
 #pragma once
-// Running a helper program (gnuplot) as a child process and waiting for it.
+// Running a helper program (gnuplot) as a child process, waiting for it and reading the files
+// it wrote.
 
 #include <filesystem>
 #include <string>
@@ -18,5 +19,8 @@ struct ChildExit {
 /// Throws InputError naming the program if it cannot be started (not found, not executable).
 ChildExit run_child(const std::string& program, const std::vector<std::string>& arguments,
                     const std::filesystem::path& error_file);
+
+/// The bytes a child process wrote to `file`; empty if the file is missing.
+std::string read_child_output(const std::filesystem::path& file);
 
 }  // namespace psq::reports

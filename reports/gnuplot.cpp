@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 #include "engine/core/error.hpp"
 #include "reports/child_process.hpp"
+#include "reports/html_text.hpp"
 
 namespace psq::reports {
 namespace {
@@ -17,18 +17,9 @@ bool drawable(const PlotSpec& plot, const std::pair<double, double>& point) {
   return std::isfinite(x) && std::isfinite(y) && (!plot.log_x || x > 0) && (!plot.log_y || y > 0);
 }
 
-/// A gnuplot single-quoted string: no escapes are interpreted, a quote is doubled.
+/// A gnuplot single-quoted string on one line: no escapes are interpreted, a quote is doubled.
 std::string quoted(const std::string& text) {
-  std::string result = "'";
-  for (char c : text) {
-    if (c == '\'')
-      result += "''";
-    else if (c == '\n' || c == '\r')
-      result += ' ';
-    else
-      result += c;
-  }
-  return result + "'";
+  return "'" + one_line_escaped(text, '\'', "''") + "'";
 }
 
 const char* style_name(PlotSpec::Style style) {
@@ -41,13 +32,6 @@ const char* style_name(PlotSpec::Style style) {
       return "linespoints lw 1.5 pt 7 ps 0.6";
   }
   return "linespoints";
-}
-
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 }  // namespace
@@ -118,7 +102,7 @@ std::vector<std::string> Gnuplot::render_svgs(const std::vector<PlotSpec>& plots
                             script.string(), exit.errors));
   std::vector<std::string> svgs;
   for (std::size_t p = 0; p < plots.size(); ++p) {
-    svgs.push_back(read_text(image(p)));
+    svgs.push_back(read_child_output(image(p)));
     if (svgs.back().find("</svg>") == std::string::npos)
       throw Error(fmt::format("gnuplot ('{}') did not draw the plot '{}': {}", program_,
                               plots[p].title, exit.errors));

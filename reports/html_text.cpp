@@ -31,6 +31,20 @@ std::string escape_html(std::string_view text) {
   return escaped;
 }
 
+std::string one_line_escaped(std::string_view text, char special, std::string_view escaped) {
+  std::string line;
+  line.reserve(text.size());
+  for (char c : text) {
+    if (c == special)
+      line += escaped;
+    else if (c == '\n' || c == '\r')
+      line += ' ';
+    else
+      line += c;
+  }
+  return line;
+}
+
 std::string base64(std::string_view bytes) {
   static constexpr std::string_view alphabet =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

@@ -3,10 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <set>
 
 #include "db/job_store.hpp"
+#include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
 #include "reports/level_metrics.hpp"
 #include "reports/parameters.hpp"
@@ -14,22 +14,16 @@
 namespace psq::reports {
 namespace {
 
-/// The file checksum recorded by the store: "fnv1a64:<16 hex digits>" or the bare digits.
-/// Empty when nothing was recorded. Throws CheckpointError for anything else.
+/// The file checksum recorded by the store (checksum_text's form); empty when nothing was
+/// recorded. Throws CheckpointError for anything else.
 std::optional<std::uint64_t> recorded_checksum(const std::string& text,
                                                const std::filesystem::path& file) {
   if (text.empty()) return std::nullopt;
-  std::string_view digits = text;
-  if (digits.starts_with("fnv1a64:")) digits.remove_prefix(8);
-  std::uint64_t value = 0;
-  const auto [end, error] =
-      std::from_chars(digits.data(), digits.data() + digits.size(), value, 16);
-  if (digits.size() != 16 || error != std::errc() || end != digits.data() + digits.size())
-    throw CheckpointError(
-        fmt::format("{}: the store records its checksum as '{}', which is not "
-                    "an FNV-1a 64 digest (16 hex digits)",
-                    file.string(), text));
-  return value;
+  if (const std::optional<std::uint64_t> checksum = parse_checksum(text)) return checksum;
+  throw CheckpointError(
+      fmt::format("{}: the store records its checksum as '{}', which is not "
+                  "an FNV-1a 64 digest (fnv1a64:<16 hex digits>)",
+                  file.string(), text));
 }
 
 /// Where a checkpoint path recorded in the store lives: absolute as is; relative against the

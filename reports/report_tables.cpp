@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "reports/html_text.hpp"
 #include "reports/parameters.hpp"
 
 namespace psq::reports {
@@ -118,21 +119,9 @@ std::string to_csv(const Table& table) {
 }
 
 std::string to_markdown(const Table& table) {
-  const auto cell = [](const std::string& text) {
-    std::string escaped;
-    for (char c : text) {
-      if (c == '|')
-        escaped += "\\|";
-      else if (c == '\n' || c == '\r')
-        escaped += ' ';
-      else
-        escaped += c;
-    }
-    return escaped;
-  };
-  const auto line = [&](const std::vector<std::string>& cells) {
+  const auto line = [](const std::vector<std::string>& cells) {
     std::vector<std::string> escaped;
-    for (const std::string& text : cells) escaped.push_back(cell(text));
+    for (const std::string& text : cells) escaped.push_back(one_line_escaped(text, '|', "\\|"));
     return "| " + joined(escaped, " | ") + " |\n";
   };
   std::string markdown = line(table.header);

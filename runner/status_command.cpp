@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include "db/job_store.hpp"
-#include "engine/core/error.hpp"
 #include "runner/commands.hpp"
 #include "runner/workspace.hpp"
 
@@ -68,12 +67,13 @@ void print_text(const std::filesystem::path& database, const std::vector<SweepRe
     std::string counts;
     for (const auto& [state, count] : report.status.counts)
       counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", db::to_string(state), count);
-    std::cout << fmt::format("sweep '{}': {} jobs: {}\n", report.status.name,
-                             report.status.total(), counts);
+    std::cout << fmt::format("sweep '{}': {} jobs: {}\n", report.status.name, report.status.total(),
+                             counts);
     if (report.status.expired_leases > 0)
-      std::cout << fmt::format("  {} running jobs stopped sending heartbeats (reclaimed by the "
-                               "next claim)\n",
-                               report.status.expired_leases);
+      std::cout << fmt::format(
+          "  {} running jobs stopped sending heartbeats (reclaimed by the "
+          "next claim)\n",
+          report.status.expired_leases);
     for (const db::Job& job : report.failures)
       std::cout << fmt::format("  {} {} ({}/{} failed attempts) {}: {}\n", db::to_string(job.state),
                                job.id, job.failures, job.max_attempts, job.parameters.dump(),
@@ -83,10 +83,7 @@ void print_text(const std::filesystem::path& database, const std::vector<SweepRe
 
 int run_status(const StatusOptions& options) {
   const std::filesystem::path database = database_path(options.database);
-  if (!std::filesystem::exists(database))
-    throw InputError(fmt::format("{}: no job store here; add a sweep first (psq sweep add FILE) "
-                                 "or choose the store with --db or PSQ_DB",
-                                 database.string()));
+  require_database(database);
   db::JobStore store(database);
   const std::vector<SweepReport> reports = gather(store, options.sweep);
   if (options.json)

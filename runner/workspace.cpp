@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <iostream>
+#include <memory>
 
 #include "engine/core/error.hpp"
 
@@ -45,6 +47,27 @@ db::JobSelection sweep_or_job(db::JobStore& store, const std::string& target) {
       fmt::format("{}: '{}' is neither a sweep nor a job id (psq status lists the "
                   "sweeps, psq results SWEEP their jobs)",
                   store.path().string(), target));
+}
+
+void register_sweep_or_job_command(CLI::App& app, std::vector<Command>& commands,
+                                   const std::string& name, const std::string& description,
+                                   SweepOrJobAction action) {
+  struct Options {
+    std::string target;
+    std::string database;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand(name, description);
+  command->add_option("target", options->target, "Sweep name or job id")->required();
+  add_database_option(*command, options->database);
+  const auto run = [options, action = std::move(action)] {
+    const std::filesystem::path database = database_path(options->database);
+    require_database(database);
+    db::JobStore store(database);
+    std::cout << action(store, sweep_or_job(store, options->target), options->target) << '\n';
+    return 0;
+  };
+  commands.push_back({command, run});
 }
 
 void add_work_options(CLI::App& command, WorkSettings& settings) {

@@ -6,9 +6,12 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "db/job_store.hpp"
+#include "runner/commands.hpp"
 
 namespace psq::runner {
 
@@ -31,6 +34,16 @@ void require_database(const std::filesystem::path& database);
 /// The sweep named `target`, else the job with that id. Throws InputError naming the store when
 /// neither exists.
 db::JobSelection sweep_or_job(db::JobStore& store, const std::string& target);
+
+/// What `psq <command> SWEEP|JOB` does to the selected jobs; returns the line to print.
+using SweepOrJobAction = std::function<std::string(
+    db::JobStore& store, const db::JobSelection& jobs, const std::string& target)>;
+
+/// Adds `psq <name> TARGET [--db PATH]`, which runs `action` on the sweep or job named TARGET
+/// (sweep_or_job) of an existing store (require_database) and prints its line.
+void register_sweep_or_job_command(CLI::App& app, std::vector<Command>& commands,
+                                   const std::string& name, const std::string& description,
+                                   SweepOrJobAction action);
 
 /// How `psq work` and `psq resume` run jobs.
 struct WorkSettings {

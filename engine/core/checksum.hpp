@@ -4,7 +4,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace psq {
@@ -23,5 +26,16 @@ class Fnv1a64 {
 
 /// FNV-1a 64 of a byte sequence in one call.
 [[nodiscard]] std::uint64_t fnv1a64(std::span<const std::byte> bytes);
+
+/// FNV-1a 64 of a file's bytes, read in blocks; nothing if the file cannot be read (the caller
+/// names the file in its own error).
+[[nodiscard]] std::optional<std::uint64_t> file_fnv1a64(const std::filesystem::path& file);
+
+/// "fnv1a64:<16 hex digits>": the text form of a checksum wherever one is stored (the job store's
+/// checkpoint checksums, the scene hash in a job's parameters).
+[[nodiscard]] std::string checksum_text(std::uint64_t checksum);
+
+/// The value of checksum_text's form; nothing for any other text.
+[[nodiscard]] std::optional<std::uint64_t> parse_checksum(std::string_view text);
 
 }  // namespace psq

@@ -1,8 +1,10 @@
+#include "engine/core/checksum.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string_view>
 
-#include "engine/core/checksum.hpp"
+#include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
@@ -32,6 +34,26 @@ TEST(Fnv1a64, EverySingleByteChangeIsDetected) {
       EXPECT_NE(fnv_of(changed), reference) << "byte " << i << " bit " << bit;
     }
   }
+}
+
+TEST(ChecksumText, ReadsBackWhatItWritesAndNothingElse) {
+  EXPECT_EQ(checksum_text(0xaf63dc4c8601ec8cull), "fnv1a64:af63dc4c8601ec8c");
+  EXPECT_EQ(checksum_text(0xaa), "fnv1a64:00000000000000aa");
+  EXPECT_EQ(parse_checksum(checksum_text(0x0123456789abcdefull)), 0x0123456789abcdefull);
+  EXPECT_FALSE(parse_checksum("00000000000000aa"));           // the bare digits
+  EXPECT_FALSE(parse_checksum("fnv1a64:aa"));                 // too short
+  EXPECT_FALSE(parse_checksum("fnv1a64:00000000000000aa0"));  // too long
+  EXPECT_FALSE(parse_checksum("fnv1a64:00000000000000ag"));
+  EXPECT_FALSE(parse_checksum(""));
+}
+
+TEST(FileFnv1a64, HashesTheFileBytesAndReportsAnUnreadableFile) {
+  const auto dir = test::fresh_temp_dir("checksum");
+  // More than one read block (64 KiB), so the blocks are chained.
+  const std::string bytes(200000, '\x5a');
+  EXPECT_EQ(file_fnv1a64(test::write_file(dir / "data", bytes)), fnv_of(bytes));
+  EXPECT_EQ(file_fnv1a64(test::write_file(dir / "empty", "")), fnv_of(""));
+  EXPECT_FALSE(file_fnv1a64(dir / "missing"));
 }
 
 }  // namespace

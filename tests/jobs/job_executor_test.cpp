@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "db/job_store.hpp"
+#include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
 #include "jobs/run_directory.hpp"
 #include "jobs/sweep_file.hpp"
@@ -179,7 +180,7 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
     const fs::path file = run_dir().level_checkpoint(level.level);
     EXPECT_EQ(fs::path(level.checkpoint_path), fs::absolute(file));
     // The recorded checksum is the file's: read_checkpoint verifies it.
-    const auto checksum = jobs::parse_checksum(level.checkpoint_checksum);
+    const auto checksum = parse_checksum(level.checkpoint_checksum);
     ASSERT_TRUE(checksum);
     EXPECT_EQ(read_checkpoint(file, *checksum).level, level.level);
     EXPECT_GT(level.timings.at("checkpoint"), 0.0);

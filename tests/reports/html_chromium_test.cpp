@@ -19,13 +19,6 @@ namespace {
 
 constexpr const char* kChromium = "/usr/bin/chromium";
 
-std::string read_bytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 /// Runs headless Chromium (at most a minute) with a private profile.
 test::ProcessResult chromium(const std::filesystem::path& profile,
                              std::vector<std::string> arguments) {
@@ -96,8 +89,9 @@ TEST(HtmlReportInChromium, ShowsEveryPlotAndPictureAndScreenshotsAsARealPage) {
   ASSERT_TRUE(std::filesystem::exists(screenshot)) << shot.errors;
   EXPECT_GT(std::filesystem::file_size(screenshot), 50'000u);  // a blank page is a few kB
 
-  const auto probe = test::write_file(dir / "report" / "probe.html",
-                                      probe_page(read_bytes(outcome.page), read_bytes(screenshot)));
+  const auto probe = test::write_file(
+      dir / "report" / "probe.html",
+      probe_page(test::read_report_file(outcome.page), test::read_report_file(screenshot)));
   const auto dump = chromium(
       dir / "profile", {"--dump-dom", "--virtual-time-budget=10000", "file://" + probe.string()});
   ASSERT_EQ(dump.exit_code, 0) << dump.errors;

@@ -1,4 +1,4 @@
-// HTML escaping and base64 (RFC 4648 test vectors).
+// HTML escaping, one-line escaping and base64 (RFC 4648 test vectors).
 
 #include "reports/html_text.hpp"
 
@@ -22,6 +22,12 @@ TEST(HtmlText, EscapesMarkupCharacters) {
   EXPECT_EQ(escape_html(R"(<a href="x">Tom & 'Jerry'</a>)"),
             "&lt;a href=&quot;x&quot;&gt;Tom &amp; &#39;Jerry&#39;&lt;/a&gt;");
   EXPECT_EQ(escape_html("drapé 1e-3"), "drapé 1e-3");
+}
+
+TEST(HtmlText, OneLineEscapingReplacesTheSpecialCharacterAndLineBreaks) {
+  EXPECT_EQ(one_line_escaped("a|b\r\nc", '|', "\\|"), "a\\|b  c");
+  EXPECT_EQ(one_line_escaped("it's", '\'', "''"), "it''s");
+  EXPECT_EQ(one_line_escaped("", '|', "x"), "");
 }
 
 }  // namespace

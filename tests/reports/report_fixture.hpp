@@ -12,18 +12,20 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "db/job_store.hpp"
+#include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
 
 namespace psq::test {
 
 /// How a level's checkpoint is recorded in the store.
 enum class CheckpointCase {
-  absolute_path,       ///< written, recorded by absolute path with "fnv1a64:" checksum
-  workspace_relative,  ///< written, recorded relative to the store's directory, bare checksum
+  absolute_path,       ///< written, recorded by absolute path
+  workspace_relative,  ///< written, recorded relative to the store's directory
   corrupted,           ///< written, recorded, then damaged on disk
   missing,             ///< recorded, never written
 };
@@ -56,6 +58,14 @@ struct FixtureJob {
             {"scene", "fnv1a64:00000000000000aa"}};
   }
 };
+
+/// The bytes of a file (a report's output) read back whole.
+inline std::string read_report_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
 
 /// Newton-like history: per frame, the residual drops quadratically from `start`.
 inline std::vector<double> newton_history(int frames, double start) {
@@ -231,8 +241,7 @@ inline std::filesystem::path make_report_fixture(const std::filesystem::path& di
         const bool relative_path = level.checkpoint == CheckpointCase::workspace_relative ||
                                    level.checkpoint == CheckpointCase::corrupted;
         record.checkpoint_path = relative_path ? relative : file.string();
-        record.checkpoint_checksum = relative_path ? fmt::format("{:016x}", checksum)
-                                                   : fmt::format("fnv1a64:{:016x}", checksum);
+        record.checkpoint_checksum = checksum_text(checksum);  // as the executor records it
         if (level.checkpoint == CheckpointCase::corrupted) {
           std::fstream bytes(file, std::ios::in | std::ios::out | std::ios::binary);
           bytes.seekp(static_cast<std::streamoff>(std::filesystem::file_size(file) / 2));

@@ -14,6 +14,7 @@
 #include "db/job_store.hpp"
 #include "engine/io/checkpoint.hpp"
 #include "jobs/psq_child.hpp"
+#include "runner/cantilever_workspace.hpp"
 #include "support/run_process.hpp"
 #include "support/test_paths.hpp"
 
@@ -25,19 +26,13 @@ namespace fs = std::filesystem;
 constexpr double kLease = 0.4;  // seconds; short, so a killed worker's job is free again soon
 
 /// A workspace with an 8-job sweep of a rubber cantilever (20 to 100 Newton iterations a job).
-struct Sweep {
-  fs::path dir;
-  fs::path db;
-
-  explicit Sweep(const std::string& name) : dir(test::fresh_temp_dir(name)), db(dir / "psq.db") {
-    fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir / "scene.toml");
-    test::write_file(dir / "sweep.toml",
-                     "name = \"k\"\nscene = \"scene.toml\"\n[grid]\n"
-                     "\"shell.strip.material.thickness\" = [5e-4, 6e-4, 7e-4, 8e-4, 9e-4, 1e-3, "
-                     "1.2e-3, 1.5e-3]\n"
-                     "\"shell.strip.material.youngs_modulus\" = [5e6]\n");
+struct Sweep : test::CantileverWorkspace {
+  explicit Sweep(const std::string& name) : CantileverWorkspace(name) {
     const test::ProcessResult added =
-        test::run_psq({"sweep", "add", (dir / "sweep.toml").string(), "--db", db.string()});
+        add_sweep("k",
+                  "\"shell.strip.material.thickness\" = [5e-4, 6e-4, 7e-4, 8e-4, 9e-4, 1e-3, "
+                  "1.2e-3, 1.5e-3]\n"
+                  "\"shell.strip.material.youngs_modulus\" = [5e6]\n");
     EXPECT_EQ(added.exit_code, 0) << added.errors;
   }
 
@@ -57,9 +52,6 @@ struct Sweep {
     return child.wait();
   }
 
-  std::vector<db::JobResult> results() const {
-    return db::JobStore(db).results(db::JobSelection::all());
-  }
   Checkpoint final_checkpoint(const std::string& job) const {
     return read_checkpoint(dir / "runs" / job / "level_0.h5");
   }

@@ -2,33 +2,32 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "runner/cantilever_workspace.hpp"
 #include "support/run_process.hpp"
-#include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
 
-namespace fs = std::filesystem;
-
 class ResultsCommand : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = test::fresh_temp_dir("results_command");
-    fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir_ / "scene.toml");
-    test::write_file(dir_ / "sweep.toml",
-                     "name = \"r\"\nscene = \"scene.toml\"\n[grid]\n\"time.frames\" = [2]\n"
-                     "\"shell.strip.material.thickness\" = [1e-3, 2e-3]\n");
-    ASSERT_EQ(psq({"sweep", "add", (dir_ / "sweep.toml").string()}).exit_code, 0);
+    workspace_ = std::make_unique<test::CantileverWorkspace>("results_command");
+    ASSERT_EQ(workspace_
+                  ->add_sweep("r",
+                              "\"time.frames\" = [2]\n"
+                              "\"shell.strip.material.thickness\" = [1e-3, 2e-3]\n")
+                  .exit_code,
+              0);
     ASSERT_EQ(psq({"work", "--workers", "1"}).exit_code, 0);
   }
   static test::ProcessResult psq(std::vector<std::string> arguments) {
-    arguments.insert(arguments.end(), {"--db", (dir_ / "psq.db").string()});
-    return test::run_psq(arguments);
+    return workspace_->psq(arguments);
   }
-  static inline fs::path dir_;
+  static inline std::unique_ptr<test::CantileverWorkspace> workspace_;
 };
 
 TEST_F(ResultsCommand, CsvHasOneRowPerJobLevelWithItsParameters) {

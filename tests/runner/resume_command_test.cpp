@@ -6,8 +6,8 @@
 #include <thread>
 
 #include "db/job_store.hpp"
+#include "runner/cantilever_workspace.hpp"
 #include "support/run_process.hpp"
-#include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
@@ -15,21 +15,11 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(ResumeCommand, RequeuesExpiredJobsOfTheSweepWithoutCountingAFailure) {
-  const fs::path dir = test::fresh_temp_dir("resume_command");
-  const fs::path db = dir / "psq.db";
-  const auto psq = [&](std::vector<std::string> arguments) {
-    arguments.insert(arguments.end(), {"--db", db.string()});
-    return test::run_psq(arguments);
-  };
-  fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir / "scene.toml");
-  test::write_file(dir / "a.toml",
-                   "name = \"a\"\nscene = \"scene.toml\"\n[grid]\n"
-                   "\"time.frames\" = [2]\n");
-  test::write_file(dir / "b.toml",
-                   "name = \"b\"\nscene = \"scene.toml\"\n[grid]\n"
-                   "\"time.frames\" = [3]\n");
-  ASSERT_EQ(psq({"sweep", "add", (dir / "a.toml").string()}).exit_code, 0);
-  ASSERT_EQ(psq({"sweep", "add", (dir / "b.toml").string()}).exit_code, 0);
+  const test::CantileverWorkspace workspace("resume_command");
+  const auto psq = [&](std::vector<std::string> arguments) { return workspace.psq(arguments); };
+  const fs::path& db = workspace.db;
+  ASSERT_EQ(workspace.add_sweep("a", "\"time.frames\" = [2]\n").exit_code, 0);
+  ASSERT_EQ(workspace.add_sweep("b", "\"time.frames\" = [3]\n").exit_code, 0);
   {
     // A worker that claimed sweep a's job and vanished.
     db::JobStore store(db);

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "db/job_store.hpp"
+#include "runner/cantilever_workspace.hpp"
 #include "support/run_process.hpp"
-#include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
@@ -12,25 +12,22 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(RetryCommand, RequeuesFailedAndCancelledJobsWhichThenRun) {
-  const fs::path dir = test::fresh_temp_dir("retry_command");
-  const fs::path db = dir / "psq.db";
-  const auto psq = [&](std::vector<std::string> arguments) {
-    arguments.insert(arguments.end(), {"--db", db.string()});
-    return test::run_psq(arguments);
-  };
-  fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir / "scene.toml");
+  const test::CantileverWorkspace workspace("retry_command");
+  const auto psq = [&](std::vector<std::string> arguments) { return workspace.psq(arguments); };
+  const fs::path& db = workspace.db;
   // Two iterations cannot reach a tolerance of 1e-30 m/s: the first job fails for good.
-  test::write_file(dir / "sweep.toml",
-                   "name = \"t\"\nscene = \"scene.toml\"\n[grid]\n"
-                   "\"time.frames\" = [2]\n[[zip]]\n"
-                   "\"solver.max_iterations\" = [2, 50]\n"
-                   "\"solver.tolerance\" = [1e-30, 1e-5]\n");
-  ASSERT_EQ(psq({"sweep", "add", (dir / "sweep.toml").string()}).exit_code, 0);
-  std::vector<db::JobResult> jobs = db::JobStore(db).results(db::JobSelection::all());
+  ASSERT_EQ(workspace
+                .add_sweep("t",
+                           "\"time.frames\" = [2]\n[[zip]]\n"
+                           "\"solver.max_iterations\" = [2, 50]\n"
+                           "\"solver.tolerance\" = [1e-30, 1e-5]\n")
+                .exit_code,
+            0);
+  std::vector<db::JobResult> jobs = workspace.results();
   ASSERT_EQ(psq({"cancel", jobs[1].job.id}).exit_code, 0);
   const auto work = psq({"work", "--workers", "1"});
   EXPECT_EQ(work.exit_code, 5) << work.errors;  // a job failed
-  jobs = db::JobStore(db).results(db::JobSelection::all());
+  jobs = workspace.results();
   EXPECT_EQ(jobs[0].job.state, db::JobState::failed);
   EXPECT_NE(jobs[0].job.error.find("did not converge"), std::string::npos) << jobs[0].job.error;
   EXPECT_EQ(jobs[1].job.state, db::JobState::cancelled);

@@ -11,6 +11,7 @@
 #include "engine/io/checkpoint.hpp"
 #include "io/xdmf_validator.hpp"
 #include "jobs/psq_child.hpp"
+#include "runner/cantilever_workspace.hpp"
 #include "support/run_process.hpp"
 #include "support/test_paths.hpp"
 
@@ -21,27 +22,14 @@ namespace fs = std::filesystem;
 
 class WorkCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = test::fresh_temp_dir("work_command");
-    fs::copy_file(test::source_dir() / "jobs/scenes/cantilever.toml", dir_ / "scene.toml");
-    db_ = dir_ / ".psq" / "psq.db";
-  }
   /// Adds a sweep over `grid` (TOML lines of the [grid] table); returns the exit code.
   int add_sweep(const std::string& grid, const std::string& name = "w") {
-    const fs::path file = test::write_file(
-        dir_ / (name + ".toml"),
-        fmt::format("name = \"{}\"\nscene = \"scene.toml\"\n[grid]\n{}", name, grid));
-    const auto result = psq({"sweep", "add", file.string()});
+    const auto result = workspace_.add_sweep(name, grid);
     add_errors_ = result.errors;
     return result.exit_code;
   }
-  test::ProcessResult psq(std::vector<std::string> arguments) {
-    arguments.insert(arguments.end(), {"--db", db_.string()});
-    return test::run_psq(arguments);
-  }
-  std::vector<db::JobResult> results() {
-    return db::JobStore(db_).results(db::JobSelection::all());
-  }
+  test::ProcessResult psq(std::vector<std::string> arguments) { return workspace_.psq(arguments); }
+  std::vector<db::JobResult> results() { return workspace_.results(); }
   /// The store opens, passes SQLite's integrity check, and every job's state agrees with its
   /// lease fields (the schema enforces the rest).
   void expect_store_consistent() {
@@ -51,7 +39,10 @@ class WorkCommand : public ::testing::Test {
       EXPECT_EQ(r.job.lease_owner.empty(), r.job.state != db::JobState::running) << r.job.id;
   }
 
-  fs::path dir_, db_;
+  // The store in the default workspace directory .psq/, with the runs and cache beside it.
+  const test::CantileverWorkspace workspace_{"work_command", fs::path(".psq") / "psq.db"};
+  const fs::path& dir_ = workspace_.dir;
+  const fs::path& db_ = workspace_.db;
   std::string add_errors_;
 };
 
