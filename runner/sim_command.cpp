@@ -2,13 +2,14 @@
 // resolution (levels = 1) or progressive over a hierarchy of L levels (docs/progressive.md).
 
 #include <fmt/format.h>
+#include <unistd.h>
+
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <unistd.h>
 
-#include "engine/core/atomic_file.hpp"
 #include "engine/contact/intersection_check.hpp"
+#include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
@@ -55,15 +56,51 @@ struct LevelRecord {
   nlohmann::json steps = nlohmann::json::array();
 
   [[nodiscard]] nlohmann::json json() const {
-    return {{"level", level},         {"vertices", vertices}, {"triangles", triangles},
-            {"iterations", iterations}, {"seconds", seconds}, {"converged", converged},
+    return {{"level", level},         {"vertices", vertices},
+            {"triangles", triangles}, {"iterations", iterations},
+            {"seconds", seconds},     {"converged", converged},
             {"steps", steps}};
   }
 };
 
+/// Refuses an initial state with intersections, prepares the output directory, prints `header`
+/// and writes frame 0 (the rest state); returns the output directory.
+std::filesystem::path start_run(const Scene& scene, const ShellSystem& system,
+                                const SimOptions& options, const std::string& header) {
+  const TriMesh& rest = system.rest_mesh();
+  require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
+                            shell_parts(system));
+  const std::filesystem::path out = prepare_output_dir(options.out);
+  std::cerr << header;
+  write_positions(frame_path(out, 0), rest, flat(rest.vertices));
+  return out;
+}
+
+/// Redraws the progress line of a Newton iteration in place ("  <where>  iteration k  …").
+void show_iteration(const std::string& where, const NewtonIteration& it) {
+  std::cerr << fmt::format("\r  {}  iteration {}  ‖Δx‖∞/Δt {:.3e}  ‖g‖ {:.3e}   ", where,
+                           it.iteration, it.step_norm, it.gradient_norm)
+            << std::flush;
+}
+
+/// The summary fields of every run; the progressive one adds its levels.
+nlohmann::json run_summary(const Scene& scene, const TriMesh& rest, double tolerance,
+                           int level_count, bool all_converged, const nlohmann::json& frames) {
+  return {{"scene", scene.name},
+          {"scene_file", scene.source.string()},
+          {"vertices", rest.vertex_count()},
+          {"triangles", rest.triangle_count()},
+          {"time_step", scene.time.step},
+          {"tolerance", tolerance},
+          {"level_count", level_count},
+          {"all_converged", all_converged},
+          {"frames", frames}};
+}
+
 /// Writes summary.json, prints its path, and returns the exit code.
 int finish(const std::filesystem::path& out, const nlohmann::json& summary, bool all_converged) {
-  write_file_atomically(out / "summary.json", [&](std::ostream& o) { o << summary.dump(2) << '\n'; });
+  write_file_atomically(out / "summary.json",
+                        [&](std::ostream& o) { o << summary.dump(2) << '\n'; });
   std::cout << (out / "summary.json").string() << '\n';
   if (!all_converged) {
     std::cerr << "psq sim: some frames or levels did not converge (see summary.json)\n";
@@ -86,44 +123,31 @@ ProgressiveSettings settings_for(const Scene& scene, const SimOptions& options) 
 int run_direct(const Scene& scene, const SimOptions& sim_options) {
   QuasistaticSimulation sim(scene);
   const TriMesh& rest = sim.system().rest_mesh();
-  require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
-                            shell_parts(sim.system()));
-  const std::filesystem::path out = prepare_output_dir(sim_options.out);
+  const std::filesystem::path out = start_run(
+      scene, sim.system(), sim_options,
+      fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, tolerance {:.3g} m/s\n",
+                  scene.name, rest.vertex_count(), rest.triangle_count(), sim.frame_count(),
+                  sim.newton_settings().tolerance));
   const bool terminal = ::isatty(STDERR_FILENO);
-  std::cerr << fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, tolerance {:.3g} m/s\n",
-                           scene.name, rest.vertex_count(), rest.triangle_count(), sim.frame_count(),
-                           sim.newton_settings().tolerance);
-  write_positions(frame_path(out, 0), rest, sim.positions());
 
   nlohmann::json frames = nlohmann::json::array();
   bool all_converged = true;
   while (sim.frame() < sim.frame_count()) {
     const FrameRecord record = sim.step([&](int frame, const NewtonIteration& it) {
-      if (terminal)
-        std::cerr << fmt::format("\r  frame {}/{}  iteration {}  ‖Δx‖∞/Δt {:.3e}  ‖g‖ {:.3e}   ", frame,
-                                 sim.frame_count(), it.iteration, it.step_norm, it.gradient_norm)
-                  << std::flush;
+      if (terminal) show_iteration(fmt::format("frame {}/{}", frame, sim.frame_count()), it);
     });
     write_positions(frame_path(out, record.frame), rest, sim.positions());
     all_converged = all_converged && record.newton.converged;
     frames.push_back(frame_json(record));
     std::cerr << fmt::format("{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}, {:.3f} s\n",
                              terminal ? "\r" : "", record.frame, sim.frame_count(),
-                             record.newton.iterations, record.newton.converged ? "converged" : "NOT converged",
+                             record.newton.iterations,
+                             record.newton.converged ? "converged" : "NOT converged",
                              record.newton.step_norm, record.newton.wall_seconds);
   }
-  const nlohmann::json summary = {
-      {"scene", scene.name},
-      {"scene_file", scene.source.string()},
-      {"vertices", rest.vertex_count()},
-      {"triangles", rest.triangle_count()},
-      {"time_step", scene.time.step},
-      {"tolerance", sim.newton_settings().tolerance},
-      {"level_count", 1},
-      {"all_converged", all_converged},
-      {"frames", frames},
-  };
-  return finish(out, summary, all_converged);
+  return finish(out,
+                run_summary(scene, rest, sim.newton_settings().tolerance, 1, all_converged, frames),
+                all_converged);
 }
 
 /// levels > 1: the progressive simulation (docs/progressive.md).
@@ -131,15 +155,13 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
                     const ProgressiveSettings& settings) {
   ProgressiveSimulation sim(scene, settings);
   const TriMesh& rest = sim.finest_system().rest_mesh();
-  require_intersection_free(rest, fmt::format("{}: initial state", scene.source.string()),
-                            shell_parts(sim.finest_system()));
-  const std::filesystem::path out = prepare_output_dir(sim_options.out);
+  const std::filesystem::path out =
+      start_run(scene, sim.finest_system(), sim_options,
+                fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, {} level(s), "
+                            "tolerance {:.3g} m/s\n",
+                            scene.name, rest.vertex_count(), rest.triangle_count(),
+                            sim.frame_count(), sim.level_count(), sim.finest_tolerance()));
   const bool terminal = ::isatty(STDERR_FILENO);
-  std::cerr << fmt::format("psq sim: '{}': {} vertices, {} triangles, {} frames, {} level(s), "
-                           "tolerance {:.3g} m/s\n",
-                           scene.name, rest.vertex_count(), rest.triangle_count(),
-                           sim.frame_count(), sim.level_count(), sim.finest_tolerance());
-  write_positions(frame_path(out, 0), rest, flat(rest.vertices));
 
   nlohmann::json frames = nlohmann::json::array();
   nlohmann::json levels = nlohmann::json::array();
@@ -151,11 +173,9 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
     while (!sim.level_done()) {
       const ProgressiveStep step = sim.step([&](int l, int frame, const NewtonIteration& it) {
         if (terminal)
-          std::cerr << fmt::format("\r  level {}/{}  frame {}/{}  iteration {}  ‖Δx‖∞/Δt {:.3e}"
-                                   "  ‖g‖ {:.3e}   ",
-                                   l, sim.level_count() - 1, frame, sim.frame_count(),
-                                   it.iteration, it.step_norm, it.gradient_norm)
-                    << std::flush;
+          show_iteration(fmt::format("level {}/{}  frame {}/{}", l, sim.level_count() - 1, frame,
+                                     sim.frame_count()),
+                         it);
       });
       // Every frame file holds the finest mesh: previews are prolonged to it.
       write_positions(frame_path(out, step.frame.frame), rest, sim.finest_positions());
@@ -181,19 +201,10 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
     if (sim.finished()) break;
     sim.refine();
   }
-  const nlohmann::json summary = {
-      {"scene", scene.name},
-      {"scene_file", scene.source.string()},
-      {"vertices", rest.vertex_count()},
-      {"triangles", rest.triangle_count()},
-      {"time_step", scene.time.step},
-      {"tolerance", sim.finest_tolerance()},
-      {"level_count", sim.level_count()},
-      {"refine_frame", sim.refine_frame()},
-      {"all_converged", all_converged},
-      {"frames", frames},
-      {"levels", levels},
-  };
+  nlohmann::json summary =
+      run_summary(scene, rest, sim.finest_tolerance(), sim.level_count(), all_converged, frames);
+  summary["refine_frame"] = sim.refine_frame();
+  summary["levels"] = levels;
   return finish(out, summary, all_converged);
 }
 
@@ -212,8 +223,9 @@ void register_sim_command(CLI::App& app, std::vector<Command>& commands) {
       "sim", "Simulate a scene, directly at its full resolution or progressively over levels");
   command->add_option("scene", options->scene, "Scene file (TOML, see docs/scene-format.md)")
       ->required();
-  command->add_option("--out", options->out,
-                      "Output directory for frame meshes, level meshes and summary.json")
+  command
+      ->add_option("--out", options->out,
+                   "Output directory for frame meshes, level meshes and summary.json")
       ->required();
   command->add_option("--levels", options->levels,
                       "Hierarchy levels (overrides [hierarchy] levels; 1 = direct)");

@@ -28,8 +28,14 @@ class DirectObjective : public LevelObjective {
   DirectObjective(const ShellSystem& system, double time_step)
       : system_(system), potential_(std::in_place, system, time_step), time_step_(time_step) {}
 
-  void set_previous(const Eigen::VectorXd& previous) override { potential_->set_previous(previous); }
-  void set_time_step(double time_step) override;
+  void set_previous(const Eigen::VectorXd& previous) override {
+    potential_->set_previous(previous);
+  }
+  void set_time_step(double time_step) override {
+    if (time_step == time_step_) return;
+    potential_.emplace(system_, time_step);  // xᵗ is reset to the rest state: set it afterwards
+    time_step_ = time_step;
+  }
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override {
     return potential_->elastic_energy(x);
   }

@@ -1,11 +1,7 @@
 #include "engine/progressive/level_stepper.hpp"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
-
-#include "engine/core/error.hpp"
 
 namespace psq {
 
@@ -24,12 +20,6 @@ bool settling_done(int settle_step, double change, double tolerance) {
   return settle_step >= kSettlingGrowthSteps && change < tolerance;
 }
 
-void DirectObjective::set_time_step(double time_step) {
-  if (time_step == time_step_) return;
-  potential_.emplace(system_, time_step);  // xᵗ is reset to the rest state: set it afterwards
-  time_step_ = time_step;
-}
-
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
                                const NewtonSolver::Progress& progress) {
   return step(x, frame, system_.scene().time.step, progress);
@@ -38,16 +28,12 @@ FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame, double time_step,
                                const NewtonSolver::Progress& progress) {
   objective_->set_time_step(time_step);
+  objective_->set_previous(x);
   FrameRecord record;
   record.frame = frame;
   record.time = frame * system_.scene().time.step;
-  objective_->set_previous(x);
-  system_.apply_pins(x, record.time);
-  if (!std::isfinite(objective_->value(x)))
-    throw NumericalError(fmt::format(
-        "frame {}: moving the pinned vertices to their scripted positions inverts or degenerates "
-        "triangles next to them; use more frames (smaller steps of the motion)", frame));
-  record.newton = newton_.minimize(*objective_, x, dofs_, settings_, progress);
+  record.newton =
+      solve_pinned_step(newton_, *objective_, system_, dofs_, settings_, frame, x, progress);
   record.elastic_energy = objective_->elastic_energy(x);
   return record;
 }

@@ -30,7 +30,6 @@ class LevelStepper {
                const NewtonSettings& settings);
 
   [[nodiscard]] const ShellSystem& system() const { return system_; }
-  [[nodiscard]] LevelObjective& objective() { return *objective_; }
   [[nodiscard]] const NewtonSettings& settings() const { return settings_; }
 
   /// One step to `frame` (time frame·Δt) from x, which becomes xᵗ; x is overwritten with the

@@ -1,5 +1,7 @@
 #include "engine/progressive/proxy_objective.hpp"
 
+#include <cstring>
+
 namespace psq {
 namespace {
 
@@ -22,14 +24,27 @@ ProxyObjective::ProxyObjective(const ShellSystem& level, const ShellSystem& fine
       gradient_kind_(gradient),
       previous_(flat(level.rest_mesh().vertices)) {}
 
+const Eigen::VectorXd& ProxyObjective::prolonged(const Eigen::VectorXd& x) const {
+  // Bitwise equality, so a hit returns exactly what apply(x) would (a non-finite x, which apply
+  // rejects, is never stored). Comparing 3n numbers is cheap next to prolonging 3m of them.
+  const bool hit = prolonged_at_.size() > 0 && x.size() == prolonged_at_.size() &&
+                   std::memcmp(x.data(), prolonged_at_.data(),
+                               sizeof(double) * static_cast<std::size_t>(x.size())) == 0;
+  if (!hit) {
+    prolonged_ = to_finest_.apply(x);
+    prolonged_at_ = x;
+  }
+  return prolonged_;
+}
+
 double ProxyObjective::elastic_energy(const Eigen::VectorXd& x) const {
-  return fine_elastics(finest_, to_finest_.apply(x));
+  return fine_elastics(finest_, prolonged(x));
 }
 
 double ProxyObjective::value(const Eigen::VectorXd& x) {
   const Eigen::VectorXd dx = x - previous_;
   const double inertia = 0.5 * inertia_weight_ * dx.dot(level_.dof_masses().cwiseProduct(dx));
-  const Eigen::VectorXd fine = to_finest_.apply(x);
+  const Eigen::VectorXd& fine = prolonged(x);
   return inertia + fine_elastics(finest_, fine) - finest_.external_force().dot(fine);
 }
 
@@ -41,7 +56,7 @@ Eigen::VectorXd ProxyObjective::fine_gradient(const Eigen::VectorXd& fine) const
 }
 
 void ProxyObjective::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-  const Eigen::VectorXd fine_g = fine_gradient(to_finest_.apply(x));
+  const Eigen::VectorXd fine_g = fine_gradient(prolonged(x));
   g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_);
   if (gradient_kind_ == ProxyGradient::exact)
     g += to_finest_.apply_jacobian_transpose(x, fine_g);

@@ -30,9 +30,7 @@ class ProxyObjective : public LevelObjective {
                  const SystemProlongation& to_finest, double time_step, ProxyGradient gradient);
 
   void set_previous(const Eigen::VectorXd& previous) override { previous_ = previous; }
-  void set_time_step(double time_step) override {
-    inertia_weight_ = 1.0 / (time_step * time_step);
-  }
+  void set_time_step(double time_step) override { inertia_weight_ = 1.0 / (time_step * time_step); }
   /// Ψ_L(P^l(x)).
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override;
 
@@ -44,6 +42,10 @@ class ProxyObjective : public LevelObjective {
  private:
   /// ∇Ψ_L(y) − f_L at fine positions y.
   [[nodiscard]] Eigen::VectorXd fine_gradient(const Eigen::VectorXd& fine) const;
+  /// P^l(x), remembered for the last x: Newton asks for the gradient at the point whose value
+  /// its line search has just accepted, and a step starts with two values at the same point,
+  /// so most prolongations would otherwise be computed twice.
+  [[nodiscard]] const Eigen::VectorXd& prolonged(const Eigen::VectorXd& x) const;
 
   const ShellSystem& level_;
   const ShellSystem& finest_;
@@ -51,6 +53,9 @@ class ProxyObjective : public LevelObjective {
   double inertia_weight_;  ///< 1/Δt²
   ProxyGradient gradient_kind_;
   Eigen::VectorXd previous_;
+  // The memo of prolonged(); mutable so that the const elastic_energy() shares it.
+  mutable Eigen::VectorXd prolonged_at_;  ///< the x of the last prolongation
+  mutable Eigen::VectorXd prolonged_;     ///< P^l(prolonged_at_)
 };
 
 }  // namespace psq

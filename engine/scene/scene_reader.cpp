@@ -251,18 +251,50 @@ std::string read_choice(const Section& section, std::string_view key, const Keys
                                       : fmt::format("expected one of {}", quoted_list(choices))));
 }
 
+// Checked numbers: each reads `key` and fails naming its requirement and the value given.
+
+/// A positive number: required, or `fallback` when absent.
+double read_positive(const Section& section, std::string_view key,
+                     std::optional<double> fallback = std::nullopt) {
+  const double value =
+      fallback ? section.get<double>(key, *fallback) : section.get_required<double>(key);
+  section.check(value > 0, key, fmt::format("positive (got {:g})", value));
+  return value;
+}
+
+/// A number that must be positive when given.
+std::optional<double> read_optional_positive(const Section& section, std::string_view key) {
+  if (!section.has(key)) return std::nullopt;
+  return read_positive(section, key);
+}
+
+/// A number of at least 0, `fallback` when absent.
+double read_non_negative(const Section& section, std::string_view key, double fallback) {
+  const double value = section.get<double>(key, fallback);
+  section.check(value >= 0, key, fmt::format("at least 0 (got {:g})", value));
+  return value;
+}
+
+/// A number in the open interval (0, 1), `fallback` when absent.
+double read_unit_fraction(const Section& section, std::string_view key, double fallback) {
+  const double value = section.get<double>(key, fallback);
+  section.check(value > 0 && value < 1, key, fmt::format("in (0, 1) (got {:g})", value));
+  return value;
+}
+
+/// An integer of at least 1 (a count of frames, levels or iterations), `fallback` when absent.
+int read_count(const Section& section, std::string_view key, int fallback) {
+  const int value = section.get<int>(key, fallback);
+  section.check(value >= 1, key, fmt::format("at least 1 (got {})", value));
+  return value;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Meshes
 
 const Keys kSheetKeys = {"generator", "width", "height", "edge_length", "structured", "holes"};
 const Keys kCylinderKeys = {"generator", "radius", "height", "edge_length"};
 const Keys kSphereKeys = {"generator", "radius", "edge_length"};
-
-double read_positive(const Section& section, std::string_view key) {
-  const double value = section.get_required<double>(key);
-  section.check(value > 0, key, fmt::format("positive (got {:g})", value));
-  return value;
-}
 
 /// The target edge length, which must be positive and smaller than the shape's smallest size.
 double read_edge_length(const Section& mesh, double smallest_size, std::string_view size_name) {
@@ -347,8 +379,7 @@ void read_placement(const Section& shell, MeshSource& source) {
   const auto placement = shell.optional_table("placement");
   if (!placement) return;
   placement->allow_only({"scale", "rotation_axis", "rotation_degrees", "translation"});
-  source.scale = placement->get<double>("scale", source.scale);
-  placement->check(source.scale > 0, "scale", fmt::format("positive (got {:g})", source.scale));
+  source.scale = read_positive(*placement, "scale", source.scale);
   source.rotation_axis = placement->get<Eigen::Vector3d>("rotation_axis", source.rotation_axis);
   check_direction(*placement, "rotation_axis", source.rotation_axis);
   source.rotation_degrees = placement->get<double>("rotation_degrees", source.rotation_degrees);
@@ -521,10 +552,8 @@ TimeStepping read_time(const Section& root) {
   const auto section = root.optional_table("time");
   if (!section) return time;
   section->allow_only({"step", "frames"});
-  time.step = section->get<double>("step", time.step);
-  section->check(time.step > 0, "step", fmt::format("positive (got {:g})", time.step));
-  time.frames = section->get<int>("frames", time.frames);
-  section->check(time.frames >= 1, "frames", fmt::format("at least 1 (got {})", time.frames));
+  time.step = read_positive(*section, "step", time.step);
+  time.frames = read_count(*section, "frames", time.frames);
   return time;
 }
 
@@ -533,13 +562,8 @@ SolverSettings read_solver(const Section& root) {
   const auto section = root.optional_table("solver");
   if (!section) return solver;
   section->allow_only({"tolerance", "max_iterations"});
-  solver.tolerance = section->get_optional<double>("tolerance");
-  if (solver.tolerance)
-    section->check(*solver.tolerance > 0, "tolerance",
-                   fmt::format("positive (got {:g})", *solver.tolerance));
-  solver.max_iterations = section->get<int>("max_iterations", solver.max_iterations);
-  section->check(solver.max_iterations >= 1, "max_iterations",
-                 fmt::format("at least 1 (got {})", solver.max_iterations));
+  solver.tolerance = read_optional_positive(*section, "tolerance");
+  solver.max_iterations = read_count(*section, "max_iterations", solver.max_iterations);
   return solver;
 }
 
@@ -550,20 +574,11 @@ HierarchyOptions read_hierarchy(const Section& root, const TimeStepping& time) {
   if (!section) return hierarchy;
   section->allow_only(
       {"levels", "vertex_ratio", "preview_tolerance", "preview_iterations", "refine_frame"});
-  hierarchy.levels = section->get<int>("levels", hierarchy.levels);
-  section->check(hierarchy.levels >= 1, "levels",
-                 fmt::format("at least 1 (got {})", hierarchy.levels));
-  hierarchy.vertex_ratio = section->get<double>("vertex_ratio", hierarchy.vertex_ratio);
-  section->check(hierarchy.vertex_ratio > 0 && hierarchy.vertex_ratio < 1, "vertex_ratio",
-                 fmt::format("in (0, 1) (got {:g})", hierarchy.vertex_ratio));
-  hierarchy.preview_tolerance = section->get_optional<double>("preview_tolerance");
-  if (hierarchy.preview_tolerance)
-    section->check(*hierarchy.preview_tolerance > 0, "preview_tolerance",
-                   fmt::format("positive (got {:g})", *hierarchy.preview_tolerance));
+  hierarchy.levels = read_count(*section, "levels", hierarchy.levels);
+  hierarchy.vertex_ratio = read_unit_fraction(*section, "vertex_ratio", hierarchy.vertex_ratio);
+  hierarchy.preview_tolerance = read_optional_positive(*section, "preview_tolerance");
   hierarchy.preview_iterations =
-      section->get<int>("preview_iterations", hierarchy.preview_iterations);
-  section->check(hierarchy.preview_iterations >= 1, "preview_iterations",
-                 fmt::format("at least 1 (got {})", hierarchy.preview_iterations));
+      read_count(*section, "preview_iterations", hierarchy.preview_iterations);
   hierarchy.refine_frame = section->get_optional<int>("refine_frame");
   if (hierarchy.refine_frame)
     section->check(*hierarchy.refine_frame >= 1 && *hierarchy.refine_frame <= time.frames,
@@ -571,13 +586,6 @@ HierarchyOptions read_hierarchy(const Section& root, const TimeStepping& time) {
                    fmt::format("a frame in 1..{} ([time] frames; got {})", time.frames,
                                *hierarchy.refine_frame));
   return hierarchy;
-}
-
-/// A number of `section` that must lie in the open interval (0, 1).
-double read_unit_fraction(const Section& section, std::string_view key, double fallback) {
-  const double value = section.get<double>(key, fallback);
-  section.check(value > 0 && value < 1, key, fmt::format("in (0, 1) (got {:g})", value));
-  return value;
 }
 
 /// The [contact] table with its optional [contact.ccd] sub-table.
@@ -589,28 +597,16 @@ ContactSettings read_contact(const Section& root) {
                        "friction", "skip_when_apart", "ccd"});
   contact.enabled = section->get_optional<bool>("enabled");
   contact.self_contact = section->get<bool>("self_contact", contact.self_contact);
-  contact.activation_distance = section->get_optional<double>("activation_distance");
-  if (contact.activation_distance)
-    section->check(*contact.activation_distance > 0, "activation_distance",
-                   fmt::format("positive (got {:g})", *contact.activation_distance));
-  contact.thickness = section->get<double>("thickness", contact.thickness);
-  section->check(contact.thickness >= 0, "thickness",
-                 fmt::format("at least 0 (got {:g})", contact.thickness));
-  contact.stiffness = section->get_optional<double>("stiffness");
-  if (contact.stiffness)
-    section->check(*contact.stiffness > 0, "stiffness",
-                   fmt::format("positive (got {:g})", *contact.stiffness));
-  contact.friction = section->get<double>("friction", contact.friction);
-  section->check(contact.friction >= 0, "friction",
-                 fmt::format("at least 0 (got {:g})", contact.friction));
+  contact.activation_distance = read_optional_positive(*section, "activation_distance");
+  contact.thickness = read_non_negative(*section, "thickness", contact.thickness);
+  contact.stiffness = read_optional_positive(*section, "stiffness");
+  contact.friction = read_non_negative(*section, "friction", contact.friction);
   contact.skip_when_apart = section->get<bool>("skip_when_apart", contact.skip_when_apart);
   if (const auto ccd = section->optional_table("ccd")) {
     ccd->allow_only({"rescaling", "ratio_bound", "max_iterations"});
     contact.ccd_rescaling = read_unit_fraction(*ccd, "rescaling", contact.ccd_rescaling);
     contact.ccd_ratio_bound = read_unit_fraction(*ccd, "ratio_bound", contact.ccd_ratio_bound);
-    contact.ccd_max_iterations = ccd->get<int>("max_iterations", contact.ccd_max_iterations);
-    ccd->check(contact.ccd_max_iterations >= 1, "max_iterations",
-               fmt::format("at least 1 (got {})", contact.ccd_max_iterations));
+    contact.ccd_max_iterations = read_count(*ccd, "max_iterations", contact.ccd_max_iterations);
   }
   return contact;
 }

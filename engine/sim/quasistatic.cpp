@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -35,6 +36,19 @@ void append_solve(NewtonResult& frame, NewtonResult solve) {
 
 }  // namespace
 
+NewtonResult solve_pinned_step(NewtonSolver& newton, Objective& objective,
+                               const ShellSystem& system, const DofMap& dofs,
+                               const NewtonSettings& settings, int frame, Eigen::VectorXd& x,
+                               const NewtonSolver::Progress& progress) {
+  system.apply_pins(x, frame * system.scene().time.step);
+  if (!std::isfinite(objective.value(x)))
+    throw NumericalError(fmt::format(
+        "frame {}: moving the pinned vertices to their scripted positions inverts or "
+        "degenerates triangles next to them; use more frames (smaller steps of the motion)",
+        frame));
+  return newton.minimize(objective, x, dofs, settings, progress);
+}
+
 QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
     : system_(scene),
       potential_(system_, scene.time.step),
@@ -43,16 +57,15 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
       previous_(x_) {
   settings_.step_scale = scene.time.step;
   settings_.max_iterations = scene.solver.max_iterations;
-  settings_.tolerance = scene.solver.tolerance.value_or(
-      1e-4 * bounding_box_diagonal(system_.rest_mesh().vertices));
+  settings_.tolerance =
+      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(system_.rest_mesh().vertices));
   if (contact_enabled(scene)) {
     contact_ = std::make_unique<ContactTerm>(system_);
     potential_.add_term(*contact_);
   }
 }
 
-void QuasistaticSimulation::begin_contact_frame(FrameRecord& record,
-                                                const NewtonSettings& settings,
+void QuasistaticSimulation::begin_contact_frame(FrameRecord& record, const NewtonSettings& settings,
                                                 const NewtonSolver::Progress& progress) {
   contact_->potential().reset_stats();
   Eigen::VectorXd base_gradient;
@@ -81,7 +94,7 @@ void QuasistaticSimulation::begin_contact_frame(FrameRecord& record,
   const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
   pull_.set_stiffness(kInitialPullStiffness);
   for (int round = 0; round < kMaxPullRounds; ++round) {
-    append_solve(record.newton, solve(pulled_dofs, settings, progress));
+    append_solve(record.newton, solve_with_contact(pulled_dofs, settings, progress));
     ++record.kinematic_rounds;
     if (move_scripted_vertices_if_safe(record.time)) break;
     pull_.set_stiffness(kPullGrowth * pull_.stiffness());
@@ -100,9 +113,9 @@ bool QuasistaticSimulation::move_scripted_vertices_if_safe(double time) {
   return true;
 }
 
-NewtonResult QuasistaticSimulation::solve(const DofMap& dofs, const NewtonSettings& settings,
-                                          const NewtonSolver::Progress& progress) {
-  if (!contact_) return newton_.minimize(potential_, x_, dofs, settings, progress);
+NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
+                                                       const NewtonSettings& settings,
+                                                       const NewtonSolver::Progress& progress) {
   NewtonResult total;
   int done = 0;
   const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
@@ -149,16 +162,12 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   if (contact_) {
     begin_contact_frame(record, settings, counted_progress);
+    append_solve(record.newton, solve_with_contact(dofs_, settings, counted_progress));
+    finish_contact_frame(record);
   } else {
-    system_.apply_pins(x_, record.time);
-    if (!std::isfinite(potential_.value(x_)))
-      throw NumericalError(fmt::format(
-          "frame {}: moving the pinned vertices to their scripted positions inverts or "
-          "degenerates triangles next to them; use more frames (smaller steps of the motion)",
-          record.frame));
+    record.newton = solve_pinned_step(newton_, potential_, system_, dofs_, settings, record.frame,
+                                      x_, counted_progress);
   }
-  append_solve(record.newton, solve(dofs_, settings, counted_progress));
-  if (contact_) finish_contact_frame(record);
   record.newton.iterations += resumed_iterations;
   frame_ = record.frame;
   record.elastic_energy = potential_.elastic_energy(x_);

@@ -22,8 +22,8 @@ namespace psq {
 
 /// One solved frame.
 struct FrameRecord {
-  int frame = 0;            ///< 1-based; frame 0 is the rest state
-  double time = 0.0;        ///< frame · Δt
+  int frame = 0;      ///< 1-based; frame 0 is the rest state
+  double time = 0.0;  ///< frame · Δt
   double elastic_energy = 0.0;
   /// Every Newton solve of the frame (pull rounds, the solve, re-solves after κ updates).
   NewtonResult newton;
@@ -37,6 +37,17 @@ struct FrameRecord {
   /// unless the targets could not be reached without intersecting.
   double kinematic_offset = 0;
 };
+
+/// One quasistatic step without contact, shared by QuasistaticSimulation and the levels of a
+/// progressive solve (so that a one-level progressive solve takes exactly the same steps): moves
+/// the pinned vertices of x to their scripted positions at frame·Δt, checks that `objective` is
+/// finite there, and minimizes it with Newton from x over the free DOFs of `dofs`, leaving the
+/// result in x. The caller sets the objective's xᵗ first.
+/// @throws NumericalError when moving the pins makes the objective non-finite, or from Newton.
+NewtonResult solve_pinned_step(NewtonSolver& newton, Objective& objective,
+                               const ShellSystem& system, const DofMap& dofs,
+                               const NewtonSettings& settings, int frame, Eigen::VectorXd& x,
+                               const NewtonSolver::Progress& progress);
 
 class QuasistaticSimulation {
  public:
@@ -79,9 +90,9 @@ class QuasistaticSimulation {
   /// Moves every scripted vertex to its target at `time` if that motion (the others held) is
   /// intersection-free by the CCD and the energy stays finite; returns whether it moved.
   bool move_scripted_vertices_if_safe(double time);
-  /// Newton on x_ over `dofs`; with contact, in chunks with IPC's κ update between them.
-  NewtonResult solve(const DofMap& dofs, const NewtonSettings& settings,
-                     const NewtonSolver::Progress& progress);
+  /// Newton on x_ over `dofs` in chunks, with IPC's κ update between them (contact scenes).
+  NewtonResult solve_with_contact(const DofMap& dofs, const NewtonSettings& settings,
+                                  const NewtonSolver::Progress& progress);
   /// The frame's contact statistics.
   void finish_contact_frame(FrameRecord& record);
 

@@ -12,8 +12,8 @@
 
 namespace psq {
 
-/// One shell's place in the concatenated system.
-struct ShellBlock {
+/// One mesh's place in the concatenated system: its runs of vertices and triangles.
+struct MeshBlock {
   std::string name;
   int first_vertex = 0;
   int vertex_count = 0;
@@ -22,16 +22,11 @@ struct ShellBlock {
   MeshTopology topology;
 };
 
-/// One collider's place in the concatenated system: its vertices follow after every shell's
-/// and are scripted (pinned) vertices without mass or elastic energy.
-struct ColliderBlock {
-  std::string name;
-  int first_vertex = 0;
-  int vertex_count = 0;
-  int first_triangle = 0;
-  int triangle_count = 0;
-  MeshTopology topology;
-};
+/// A shell's block.
+using ShellBlock = MeshBlock;
+/// A collider's block: its vertices follow after every shell's and are scripted (pinned)
+/// vertices without mass or elastic energy.
+using ColliderBlock = MeshBlock;
 
 /// Pinned vertices and where their scripted motions take them.
 struct PinnedVertex {

@@ -2,17 +2,40 @@
 // gravity and loads) on a curved unstructured mesh, and with the contact barrier between two
 // sheets in near contact, through the solver's own assembly.
 
+#include "engine/sim/incremental_potential.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 
 #include "engine/sim/contact_term.hpp"
-#include "engine/sim/incremental_potential.hpp"
 #include "engine/solver/sparse_assembler.hpp"
 #include "support/finite_difference.hpp"
 
 namespace psq {
 namespace {
+
+/// The blocks assembled over every DOF of `system` (none fixed), as a dense symmetric matrix.
+Eigen::MatrixXd assembled_hessian(const HessianBlocks& blocks, const ShellSystem& system) {
+  SparseAssembler assembler;
+  assembler.assemble(blocks, DofMap(system.rest_mesh().vertex_count(), {}));
+  return Eigen::MatrixXd(assembler.matrix()).selfadjointView<Eigen::Upper>();
+}
+
+/// Central differences (step h) of the potential's gradient at x.
+Eigen::MatrixXd fd_hessian(IncrementalPotential& potential, const Eigen::VectorXd& x, double h) {
+  return test::fd_jacobian(
+      [&](const Eigen::VectorXd& y) {
+        Eigen::VectorXd g;
+        potential.gradient(y, g);
+        return g;
+      },
+      x, h);
+}
+
+double smallest_eigenvalue(const Eigen::MatrixXd& symmetric) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(symmetric).eigenvalues().minCoeff();
+}
 
 /// An open cylinder (curved rest shape, non-zero rest angles) with gravity and a point load.
 Scene curved_scene() {
@@ -50,8 +73,8 @@ class IncrementalPotentialTest : public ::testing::Test {
 TEST_F(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
   Eigen::VectorXd g;
   potential_.gradient(x_, g);
-  const Eigen::VectorXd fd = test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); },
-                                               x_, 1e-7);
+  const Eigen::VectorXd fd =
+      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-7);
   EXPECT_LT(test::relative_error(g, fd), 1e-6);
 }
 
@@ -60,29 +83,15 @@ TEST_F(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDiffere
   potential_.hessian(x_, blocks);  // the diagonal (inertia) and the batch layout
   system_.membranes()[0].hessian(x_, blocks.batches[0], false);
   system_.bendings()[0].hessian(x_, blocks.batches[1], false);
-  const DofMap all_free(system_.rest_mesh().vertex_count(), {});
-  SparseAssembler assembler;
-  assembler.assemble(blocks, all_free);
-  const Eigen::MatrixXd upper = Eigen::MatrixXd(assembler.matrix());
-  const Eigen::MatrixXd hessian = upper.selfadjointView<Eigen::Upper>();
-  const Eigen::MatrixXd fd = test::fd_jacobian(
-      [&](const Eigen::VectorXd& y) {
-        Eigen::VectorXd g;
-        potential_.gradient(y, g);
-        return g;
-      },
-      x_, 1e-7);
-  EXPECT_LT(test::relative_error(hessian, fd), 1e-5);
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-7)), 1e-5);
 }
 
 TEST_F(IncrementalPotentialTest, SolverHessianIsPositiveSemiDefinite) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);
-  SparseAssembler assembler;
-  assembler.assemble(blocks, DofMap(system_.rest_mesh().vertex_count(), {}));
-  const Eigen::MatrixXd hessian = Eigen::MatrixXd(assembler.matrix()).selfadjointView<Eigen::Upper>();
-  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(hessian).eigenvalues().minCoeff();
-  EXPECT_GE(smallest, -1e-9 * hessian.norm());
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_GE(smallest_eigenvalue(hessian), -1e-9 * hessian.norm());
 }
 
 TEST_F(IncrementalPotentialTest, ExternalForceIsGravityPlusLoads) {
@@ -90,7 +99,8 @@ TEST_F(IncrementalPotentialTest, ExternalForceIsGravityPlusLoads) {
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
   for (Eigen::Index v = 0; v < f.size() / 3; ++v) total += f.segment<3>(3 * v);
   const double mass = system_.dof_masses().sum() / 3.0;
-  const Eigen::Vector3d expected = mass * Eigen::Vector3d(0, 0, -9.81) + Eigen::Vector3d(0.1, -0.2, 0.05);
+  const Eigen::Vector3d expected =
+      mass * Eigen::Vector3d(0, 0, -9.81) + Eigen::Vector3d(0.1, -0.2, 0.05);
   EXPECT_LT((total - expected).norm(), 1e-12);
   // Lumped mass is ρ·h·area: the cylinder's area is 2πrH up to its polygonal approximation.
   EXPECT_NEAR(mass / (500.0 * 1e-3 * 2 * M_PI * 0.05 * 0.06), 1.0, 0.02);
@@ -146,8 +156,8 @@ TEST_F(ContactPotentialTest, ContactIsASignificantPartOfTheGradient) {
 TEST_F(ContactPotentialTest, GradientMatchesFiniteDifferences) {
   Eigen::VectorXd g;
   potential_.gradient(x_, g);
-  const Eigen::VectorXd fd = test::fd_gradient(
-      [&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-9);
+  const Eigen::VectorXd fd =
+      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-9);
   EXPECT_LT(test::relative_error(g, fd), 1e-5);
 }
 
@@ -159,30 +169,15 @@ TEST_F(ContactPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences
     system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
   }
   contact_.potential().hessian(x_, blocks.batches[4], false);
-  SparseAssembler assembler;
-  assembler.assemble(blocks, DofMap(system_.rest_mesh().vertex_count(), {}));
-  const Eigen::MatrixXd hessian =
-      Eigen::MatrixXd(assembler.matrix()).selfadjointView<Eigen::Upper>();
-  const Eigen::MatrixXd fd = test::fd_jacobian(
-      [&](const Eigen::VectorXd& y) {
-        Eigen::VectorXd g;
-        potential_.gradient(y, g);
-        return g;
-      },
-      x_, 1e-9);
-  EXPECT_LT(test::relative_error(hessian, fd), 1e-4);
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-9)), 1e-4);
 }
 
 TEST_F(ContactPotentialTest, SolverHessianWithContactIsPositiveSemiDefinite) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);
-  SparseAssembler assembler;
-  assembler.assemble(blocks, DofMap(system_.rest_mesh().vertex_count(), {}));
-  const Eigen::MatrixXd hessian =
-      Eigen::MatrixXd(assembler.matrix()).selfadjointView<Eigen::Upper>();
-  const double smallest =
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(hessian).eigenvalues().minCoeff();
-  EXPECT_GE(smallest, -1e-9 * hessian.norm());
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_GE(smallest_eigenvalue(hessian), -1e-9 * hessian.norm());
 }
 
 }  // namespace
