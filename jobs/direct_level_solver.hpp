@@ -35,6 +35,7 @@ class DirectLevelSolver final : public LevelSolver {
             .iterations = record.newton.iterations,
             .step_norm = record.newton.step_norm,
             .gradient_norm = record.newton.gradient_norm,
+            .elastic_energy = record.elastic_energy,
             .times = record.newton.times};
   }
 
@@ -80,6 +81,7 @@ class ProgressiveLevelSolver final : public LevelSolver {
             .iterations = newton.iterations,
             .step_norm = newton.step_norm,
             .gradient_norm = newton.gradient_norm,
+            .elastic_energy = step.frame.elastic_energy,
             .times = newton.times};
   }
   void refine() override { simulation_.refine(); }

@@ -201,6 +201,9 @@ class JobRun {
                     candidate.file.filename().string()));
     for (int level = 0; level < checkpoint.level; ++level) add_sidecar_entry(level);
     statistics_ = std::move(checkpoint.statistics);
+    if (const auto energy = checkpoint.solver.scalars.find(kElasticEnergyScalar);
+        energy != checkpoint.solver.scalars.end())
+      frame_energy_ = energy->second;
     level_start_ = Clock::now();
     since_checkpoint_ = Clock::now();
     if (checkpoint.solver.progress == LevelProgress::level_done)
@@ -209,6 +212,7 @@ class JobRun {
 
   void start_level() {
     statistics_ = {};
+    frame_energy_.reset();
     level_start_ = Clock::now();
     since_checkpoint_ = Clock::now();
     iterations_since_checkpoint_ = 0;
@@ -230,6 +234,7 @@ class JobRun {
       const LevelFrame frame =
           solver_->step([this](int frame, const NewtonIteration& it) { on_iteration(frame, it); });
       resumed_in_frame_.reset();
+      frame_energy_ = frame.elastic_energy;
       if (!frame.converged)
         throw NotConverged(fmt::format(
             "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "
@@ -342,6 +347,7 @@ class JobRun {
     c.solver.progress = progress;
     c.solver.previous_positions = as_positions(solver_->previous());
     c.solver.iterations_in_frame = iterations_in_frame;
+    if (frame_energy_) c.solver.scalars[kElasticEnergyScalar] = *frame_energy_;
     c.statistics = statistics_;
     return c;
   }
@@ -445,6 +451,8 @@ class JobRun {
   int iterations_since_checkpoint_ = 0;
   /// (frame, iterations done) of a frame restored in progress, until its next step.
   std::optional<std::pair<int, int>> resumed_in_frame_;
+  /// Elastic energy of the last solved frame of this level (the reports' energy output).
+  std::optional<double> frame_energy_;
 };
 
 }  // namespace

@@ -19,6 +19,7 @@ struct LevelFrame {
   int iterations = 0;          ///< Newton iterations of the frame, including any before a restore
   double step_norm = 0.0;      ///< final ‖d‖∞ / Δt
   double gradient_norm = 0.0;  ///< final ‖∇E‖
+  double elastic_energy = 0.0;  ///< of the frame's result, at the finest scale (J)
   PhaseTimes times;            ///< of this step() call
 };
 

@@ -99,7 +99,7 @@ void add_checkpoint_results(std::vector<std::optional<Checkpoint>>& checkpoints,
       job.problems.push_back(
           fmt::format("finest level: positions against rest shape: {}", e.what()));
     }
-    if (const auto energy = finest->solver.scalars.find("elastic_energy");
+    if (const auto energy = finest->solver.scalars.find(kElasticEnergyScalar);
         energy != finest->solver.scalars.end())
       job.outputs.elastic_energy = energy->second;
   }

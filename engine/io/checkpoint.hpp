@@ -59,6 +59,10 @@ struct SolverState {
   std::map<std::string, double> scalars;
 };
 
+/// The scalar holding the elastic energy of the level's last solved frame, at the finest scale
+/// (J); the reports' energy output.
+inline constexpr const char* kElasticEnergyScalar = "elastic_energy";
+
 /// Statistics of the level so far.
 struct LevelStatistics {
   std::vector<IterationRecord> iterations;  ///< every Newton iteration of the level, in order

@@ -87,6 +87,18 @@ TEST_F(WorkCommand, WorkerProcessesRunASweepAndRecordEveryJob) {
     const Checkpoint c = read_checkpoint(r.levels[0].checkpoint_path);
     EXPECT_LT(c.positions.col(2).minCoeff(), -1e-5);
     EXPECT_EQ(c.frame, 10);
+    // Clapeyron: a linear elastic body in equilibrium stores half the work of its load, here
+    // ½·F·δ for the 1 mN tip line load and the tip's mean deflection δ.
+    double tip_deflection = 0.0;
+    int tip_vertices = 0;
+    for (Eigen::Index v = 0; v < c.rest_positions.rows(); ++v) {
+      if (c.rest_positions(v, 0) < 0.099) continue;
+      tip_deflection -= c.positions(v, 2) - c.rest_positions(v, 2);
+      ++tip_vertices;
+    }
+    ASSERT_GT(tip_vertices, 0);
+    const double work = 0.5 * 1e-3 * tip_deflection / tip_vertices;
+    EXPECT_NEAR(c.solver.scalars.at(kElasticEnergyScalar), work, 0.03 * work);
   }
   expect_store_consistent();
   // Nothing left: a second run has nothing to do.
