@@ -1,7 +1,7 @@
 // Real crashes: `psq work` / `psq resume` as child processes, SIGKILLed at more than 20
 // moments (inside levels, around checkpoint writes, inside database transactions, at random
 // times), resumed each time; afterwards every job is done exactly once and its result equals an
-// uninterrupted run's. Also a clean SIGTERM stop.
+// uninterrupted run's. Also a clean SIGTERM stop, and a second signal that exits at once.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -160,6 +160,28 @@ TEST(Kill, SigtermCheckpointsReleasesAndTheNextRunFinishesTheSame) {
   EXPECT_EQ(stopped.front().job.failures, 0);
   ASSERT_EQ(stopped.front().levels.size(), 1u);
   EXPECT_EQ(stopped.front().levels[0].status, db::LevelStatus::running);  // the snapshot
+  EXPECT_EQ(sweep.run("work", ""), 0);
+  expect_complete_and_equal_to_reference(sweep);
+}
+
+TEST(Kill, ASecondSignalExitsAtOnceAndTheHeldJobIsResumedLater) {
+  const Sweep sweep("kill_second_signal");
+  test::ChildOptions options;
+  options.environment["PSQ_TEST_PAUSE_AT"] = "iteration:7:stop";
+  test::PsqChild child(PSQ_EXECUTABLE, sweep.work_arguments("work"), sweep.dir, options);
+  ASSERT_TRUE(child.wait_until_stopped());
+  // Two different signals, so that both are pending when the worker continues: the first asks
+  // for a clean stop, the second must end the process before that stop runs.
+  child.signal(SIGINT);
+  child.signal(SIGTERM);
+  child.signal(SIGCONT);
+  const int code = child.wait();
+  EXPECT_TRUE(code == 128 + SIGINT || code == 128 + SIGTERM) << code << child.errors();
+  EXPECT_EQ(child.errors().find("stopped on request"), std::string::npos) << child.errors();
+  const std::vector<db::JobResult> held = sweep.results();
+  EXPECT_EQ(held.front().job.state, db::JobState::running);  // not released: it left at once
+  EXPECT_EQ(held.front().job.failures, 0);
+  wait_for_lease_expiry();
   EXPECT_EQ(sweep.run("work", ""), 0);
   expect_complete_and_equal_to_reference(sweep);
 }
