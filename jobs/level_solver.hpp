@@ -15,7 +15,7 @@ namespace psq::jobs {
 struct LevelFrame {
   int level = 0;
   int frame = 0;  ///< 1-based; frame 0 is the rest state
-  bool converged = false;
+  bool converged = false;  ///< met the level's tolerance (a preview may stop at its budget)
   int iterations = 0;          ///< Newton iterations of the frame, including any before a restore
   double step_norm = 0.0;      ///< final ‖d‖∞ / Δt
   double gradient_norm = 0.0;  ///< final ‖∇E‖

@@ -59,7 +59,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     jobs::LevelFrame record;
     record.level = level_;
     record.frame = frame;
-    record.converged = frame != fail_at_frame;
+    record.converged = !(level_ == fail_at_level && frame == fail_at_frame);
     record.iterations = iterations_;
     record.elastic_energy = x_.squaredNorm();  // any function of the result will do
     return record;
@@ -81,7 +81,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     resumed_iterations_ = iterations_in_frame;
   }
 
-  int fail_at_frame = -1;
+  int fail_at_level = -1, fail_at_frame = -1;  ///< the frame that does not converge
 
  private:
   int levels_, frames_, iterations_;
@@ -120,6 +120,7 @@ class Workspace {
         store, dir_ / "psq.db", runs.empty() ? dir_ / "runs" : runs,
         [this](const Scene&, int depth) {
           auto solver = std::make_unique<ScriptedSolver>(depth, kFrames, kIterations);
+          solver->fail_at_level = fail_at_level;
           solver->fail_at_frame = fail_at_frame;
           return solver;
         },
@@ -137,7 +138,7 @@ class Workspace {
 
   std::atomic<bool> stop{false};
   std::string log;
-  int fail_at_frame = -1;
+  int fail_at_level = -1, fail_at_frame = -1;
   double lease_seconds = 30.0;
 
  private:
@@ -268,14 +269,28 @@ TEST_F(Executor, WithNoValidCheckpointTheJobStartsOver) {
   expect_same_as_reference(final_checkpoint());
 }
 
-TEST_F(Executor, AFrameThatDoesNotConvergeFailsTheJobForGood) {
+TEST_F(Executor, AFinestFrameThatDoesNotConvergeFailsTheJobForGood) {
+  fail_at_level = 1;
   fail_at_frame = 3;
   ASSERT_EQ(run(), jobs::RunOutcome::failed);
   const db::JobResult r = result();
   EXPECT_EQ(r.job.state, db::JobState::failed);
-  EXPECT_NE(r.job.error.find("level 0 frame 3 did not converge"), std::string::npos) << r.job.error;
-  ASSERT_EQ(r.levels.size(), 1u);
-  EXPECT_EQ(r.levels[0].status, db::LevelStatus::failed);
+  EXPECT_NE(r.job.error.find("level 1 frame 3 did not converge"), std::string::npos) << r.job.error;
+  ASSERT_EQ(r.levels.size(), 2u);
+  EXPECT_EQ(r.levels[0].status, db::LevelStatus::done);
+  EXPECT_EQ(r.levels[1].status, db::LevelStatus::failed);
+}
+
+TEST_F(Executor, APreviewFrameMayStopAtItsIterationBudget) {
+  // Coarse levels are previews with a fixed Newton budget per frame (progressive_simulation.hpp):
+  // only the finest level has to converge.
+  fail_at_level = 0;
+  fail_at_frame = 3;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  const db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::done);
+  ASSERT_EQ(r.levels.size(), 2u);
+  EXPECT_EQ(r.levels[0].status, db::LevelStatus::done);
 }
 
 TEST_F(Executor, AnUnwritableRunsDirectoryReleasesTheJobAndStopsTheWorker) {
