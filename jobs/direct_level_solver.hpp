@@ -49,7 +49,8 @@ class DirectLevelSolver final : public LevelSolver {
   Positions finest_positions() const override { return as_positions(simulation_.positions()); }
 
   void restore(int level, int frame, const Eigen::VectorXd& positions,
-               const Eigen::VectorXd& previous, int iterations_in_frame) override {
+               const Eigen::VectorXd& previous, int iterations_in_frame,
+               const std::map<std::string, double>& /*state*/) override {
     if (level != 0)
       throw std::invalid_argument(fmt::format("restore: level {} of a direct solve", level));
     simulation_.restore(frame, positions, previous, iterations_in_frame);
@@ -91,11 +92,11 @@ class ProgressiveLevelSolver final : public LevelSolver {
   Positions finest_positions() const override {
     return as_positions(simulation_.finest_positions());
   }
-  /// An in-frame snapshot restarts its frame from the snapshot's positions: the result meets
-  /// the same tolerance but is not bitwise the uninterrupted one.
+  std::map<std::string, double> state() const override { return simulation_.schedule_state(); }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
-               const Eigen::VectorXd& previous, int /*iterations_in_frame*/) override {
-    simulation_.restore(level, frame, positions, previous);
+               const Eigen::VectorXd& previous, int iterations_in_frame,
+               const std::map<std::string, double>& state) override {
+    simulation_.restore(level, frame, positions, previous, iterations_in_frame, state);
   }
 
  private:

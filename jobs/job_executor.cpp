@@ -182,7 +182,8 @@ class JobRun {
         const bool in_frame = checkpoint.solver.progress == LevelProgress::inside_frame;
         solver_->restore(checkpoint.level, checkpoint.frame, flat(checkpoint.positions),
                          flat(checkpoint.solver.previous_positions),
-                         in_frame ? checkpoint.solver.iterations_in_frame : 0);
+                         in_frame ? checkpoint.solver.iterations_in_frame : 0,
+                         checkpoint.solver.scalars);
         if (in_frame) resumed_in_frame_ = {checkpoint.frame, checkpoint.solver.iterations_in_frame};
         continue_from(candidate, std::move(checkpoint));
         return;
@@ -350,6 +351,7 @@ class JobRun {
     c.solver.progress = progress;
     c.solver.previous_positions = as_positions(solver_->previous());
     c.solver.iterations_in_frame = iterations_in_frame;
+    c.solver.scalars = solver_->state();
     if (frame_energy_) c.solver.scalars[kElasticEnergyScalar] = *frame_energy_;
     c.statistics = statistics_;
     return c;

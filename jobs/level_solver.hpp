@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <map>
+#include <string>
 
 #include "engine/mesh/tri_mesh.hpp"
 #include "engine/solver/solver_stats.hpp"
@@ -14,13 +16,13 @@ namespace psq::jobs {
 /// One solved frame of a level.
 struct LevelFrame {
   int level = 0;
-  int frame = 0;  ///< 1-based; frame 0 is the rest state
-  bool converged = false;  ///< met the level's tolerance (a preview may stop at its budget)
-  int iterations = 0;          ///< Newton iterations of the frame, including any before a restore
-  double step_norm = 0.0;      ///< final ‖d‖∞ / Δt
-  double gradient_norm = 0.0;  ///< final ‖∇E‖
+  int frame = 0;                ///< 1-based; frame 0 is the rest state
+  bool converged = false;       ///< met the level's tolerance (a preview may stop at its budget)
+  int iterations = 0;           ///< Newton iterations of the frame, including any before a restore
+  double step_norm = 0.0;       ///< final ‖d‖∞ / Δt
+  double gradient_norm = 0.0;   ///< final ‖∇E‖
   double elastic_energy = 0.0;  ///< of the frame's result, at the finest scale (J)
-  PhaseTimes times;            ///< of this step() call
+  PhaseTimes times;             ///< of this step() call
 };
 
 class LevelSolver {
@@ -54,12 +56,17 @@ class LevelSolver {
   [[nodiscard]] virtual const TriMesh& level_rest_mesh() const = 0;
   /// The current level's state prolonged to the finest mesh (positions() at the finest level).
   [[nodiscard]] virtual Positions finest_positions() const = 0;
+  /// Further state the solver needs to continue exactly, by name (stored in checkpoints as
+  /// solver scalars and handed back to restore()); none by default.
+  [[nodiscard]] virtual std::map<std::string, double> state() const { return {}; }
   /// Continues from a checkpoint of level `level`. With `iterations_in_frame` = 0, frame
   /// `frame` is solved and `positions` is its result; otherwise frame `frame` is in progress
   /// after that many Newton iterations from xᵗ = `previous`, and the next step() continues it
-  /// so that the result equals an uninterrupted run's.
+  /// so that the result equals an uninterrupted run's. `state` is what state() returned at
+  /// that moment (or empty for a checkpoint without it).
   virtual void restore(int level, int frame, const Eigen::VectorXd& positions,
-                       const Eigen::VectorXd& previous, int iterations_in_frame) = 0;
+                       const Eigen::VectorXd& previous, int iterations_in_frame,
+                       const std::map<std::string, double>& state) = 0;
 };
 
 }  // namespace psq::jobs

@@ -27,13 +27,29 @@ FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
 
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame, double time_step,
                                const NewtonSolver::Progress& progress) {
+  const Eigen::VectorXd previous = x;
+  return step(previous, x, frame, time_step, 0, progress);
+}
+
+FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd& x, int frame,
+                               double time_step, int iterations_done,
+                               const NewtonSolver::Progress& progress) {
   objective_->set_time_step(time_step);
-  objective_->set_previous(x);
+  objective_->set_previous(previous);
   FrameRecord record;
   record.frame = frame;
   record.time = frame * system_.scene().time.step;
+  NewtonSettings settings = settings_;
+  settings.max_iterations -= iterations_done;
+  const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
+    if (!progress) return;
+    NewtonIteration counted = it;
+    counted.iteration += iterations_done;
+    progress(counted);
+  };
   record.newton =
-      solve_pinned_step(newton_, *objective_, system_, dofs_, settings_, frame, x, progress);
+      solve_pinned_step(newton_, *objective_, system_, dofs_, settings, frame, x, numbered);
+  record.newton.iterations += iterations_done;
   record.elastic_energy = objective_->elastic_energy(x);
   return record;
 }

@@ -40,6 +40,12 @@ class LevelStepper {
   /// The same as a settling step: the inertia-like term uses `time_step` instead of Δt.
   FrameRecord step(Eigen::VectorXd& x, int frame, double time_step,
                    const NewtonSolver::Progress& progress = {});
+  /// A step from xᵗ = `previous` that already took `iterations_done` Newton iterations and
+  /// reached the iterate x: Newton continues from x with the iterations left, numbering them
+  /// (and counting them in the record) after those done, so that a step resumed from a stored
+  /// iterate ends exactly where the uninterrupted one does. x is overwritten with the result.
+  FrameRecord step(const Eigen::VectorXd& previous, Eigen::VectorXd& x, int frame, double time_step,
+                   int iterations_done, const NewtonSolver::Progress& progress = {});
 
  private:
   const ShellSystem& system_;

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "engine/core/error.hpp"
 
@@ -12,6 +14,12 @@ namespace {
 
 /// How much coarser than the current (more refined) levels a preview tolerance defaults to.
 constexpr double kPreviewToleranceFactor = 10.0;
+
+// Names of the schedule_state() scalars.
+constexpr const char* kFramesDone = "progressive.frames_done";
+constexpr const char* kSettleSteps = "progressive.settle_steps";
+constexpr const char* kSettled = "progressive.settled";
+constexpr const char* kLevelConverged = "progressive.level_converged";
 
 void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
   const auto fail = [&](const std::string& what) {
@@ -30,8 +38,9 @@ void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
                      *s.refine_frame));
   if (!scene.colliders.empty() || scene.contact.enabled.value_or(false) ||
       scene.contact.self_contact)
-    fail("progressive simulation handles scenes without contact only (no [[collider]], "
-         "[contact] off); contact-safe refinement is not implemented yet");
+    fail(
+        "progressive simulation handles scenes without contact only (no [[collider]], "
+        "[contact] off); contact-safe refinement is not implemented yet");
   if (settings.max_settle_steps < 1)
     fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
 }
@@ -82,8 +91,8 @@ void ProgressiveSimulation::initialize() {
     level_count_ = std::max(level_count_, hierarchies_[s].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
-  finest_tolerance_ = scene.solver.tolerance.value_or(
-      1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
+  finest_tolerance_ =
+      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
@@ -99,10 +108,10 @@ void ProgressiveSimulation::build_prolongations() {
       const int here = shell_level(h, level, level_count_);
       const int next = shell_level(h, level + 1, level_count_);
       const TriMesh& rest = h.levels[here].rest;
-      finest_maps.push_back(here + 1 == h.level_count()
-                                ? identity_prolongation(rest)
-                                : ShellProlongation(rest, h.levels[here].finest,
-                                                    h.finest().rest.vertices));
+      finest_maps.push_back(
+          here + 1 == h.level_count()
+              ? identity_prolongation(rest)
+              : ShellProlongation(rest, h.levels[here].finest, h.finest().rest.vertices));
       next_maps.push_back(next == here ? identity_prolongation(rest)
                                        : ShellProlongation(rest, h.levels[here].next_finer,
                                                            h.levels[next].rest.vertices));
@@ -173,13 +182,14 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   const double time_step = out.settling
                                ? settling_time_step(finest_.scene().time.step, settle_steps_)
                                : finest_.scene().time.step;
-  Eigen::VectorXd x = x_;
-  out.frame = stepper_->step(x, frame, time_step, [&](const NewtonIteration& it) {
-    if (progress) progress(level_, frame, it);
-  });
-  out.change = (x - x_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
-  previous_ = std::move(x_);
-  x_ = std::move(x);
+  // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
+  const int iterations_done = std::exchange(resumed_iterations_, 0);
+  if (iterations_done == 0) previous_ = x_;
+  out.frame = stepper_->step(previous_, x_, frame, time_step, iterations_done,
+                             [&](const NewtonIteration& it) {
+                               if (progress) progress(level_, frame, it);
+                             });
+  out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
   if (out.settling) {
     level_converged_ = settling_done(settle_steps_, out.change, tolerance());
@@ -202,25 +212,52 @@ void ProgressiveSimulation::refine() {
   previous_ = x_;
 }
 
+std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
+  return {{kFramesDone, frame_},
+          {kSettleSteps, settle_steps_},
+          {kSettled, settled_ ? 1.0 : 0.0},
+          {kLevelConverged, level_converged_ ? 1.0 : 0.0}};
+}
+
 void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd& positions,
-                                    const Eigen::VectorXd& previous) {
+                                    const Eigen::VectorXd& previous, int iterations_in_frame,
+                                    const std::map<std::string, double>& schedule_state) {
   if (level < 0 || level >= level_count_)
     throw std::invalid_argument(
         fmt::format("ProgressiveSimulation::restore: level {} of {}", level, level_count_));
   const int last_frame = level + 1 < level_count_ ? refine_frame_ : frame_count();
   const int first_frame = level == 0 ? 0 : refine_frame_;
   if (frame < first_frame || frame > last_frame)
+    throw std::invalid_argument(
+        fmt::format("ProgressiveSimulation::restore: frame {} is outside level {}'s frames {}..{}",
+                    frame, level, first_frame, last_frame));
+  if (iterations_in_frame < 0)
     throw std::invalid_argument(fmt::format(
-        "ProgressiveSimulation::restore: frame {} is outside level {}'s frames {}..{}", frame,
-        level, first_frame, last_frame));
+        "ProgressiveSimulation::restore: {} iterations in the frame", iterations_in_frame));
   enter_level(level);
   const Eigen::Index size = level_system().rest_mesh().vertices.size();
   if (positions.size() != size || previous.size() != size)
     throw std::invalid_argument(fmt::format(
         "ProgressiveSimulation::restore: level {} has {} unknowns, got {} positions and {} "
-        "previous", level, size, positions.size(), previous.size()));
+        "previous",
+        level, size, positions.size(), previous.size()));
   x_ = positions;
   previous_ = previous;
+  const auto stored = [&](const char* name) -> std::optional<double> {
+    const auto found = schedule_state.find(name);
+    if (found == schedule_state.end()) return std::nullopt;
+    return found->second;
+  };
+  const auto frames_done = stored(kFramesDone), settle_steps = stored(kSettleSteps),
+             settled = stored(kSettled), converged = stored(kLevelConverged);
+  if (frames_done && settle_steps && settled && converged) {
+    frame_ = static_cast<int>(*frames_done);
+    settle_steps_ = static_cast<int>(*settle_steps);
+    settled_ = *settled != 0.0;
+    level_converged_ = *converged != 0.0;
+    resumed_iterations_ = iterations_in_frame;
+    return;
+  }
   frame_ = frame;
   settled_ = !settles() || frame > refine_frame_;
   level_converged_ = settled_;

@@ -18,7 +18,9 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/hierarchy/mesh_hierarchy.hpp"
@@ -104,12 +106,18 @@ class ProgressiveSimulation {
   /// Moves to the next level from the current (done) one. @throws std::logic_error when the
   /// level is not done or already the finest.
   void refine();
-  /// Resumes from a stored state: `level`, the frame reached, the level's positions and xᵗ.
-  /// A level restored at its refine frame takes one more settling step before it counts as
-  /// done (the stored state does not say whether it had settled; a settled state passes that
-  /// step at once).
+  /// The schedule's position within the current level besides the frame: what restore() needs
+  /// to continue exactly (stored with checkpoints as named scalars).
+  [[nodiscard]] std::map<std::string, double> schedule_state() const;
+  /// Resumes from a stored state: `level`, the frame reached (or being solved, when
+  /// `iterations_in_frame` > 0), the level's positions (the Newton iterate after that many
+  /// iterations of the frame) and xᵗ. With the schedule_state() of the same moment the run
+  /// continues exactly as the uninterrupted one. Without it (an older checkpoint) a level
+  /// restored at its refine frame takes one more settling step before it counts as done, and a
+  /// frame in progress is started again from the stored iterate.
   void restore(int level, int frame, const Eigen::VectorXd& positions,
-               const Eigen::VectorXd& previous);
+               const Eigen::VectorXd& previous, int iterations_in_frame = 0,
+               const std::map<std::string, double>& schedule_state = {});
 
  private:
   /// Validates the hierarchies, resolves the tolerances, enters level 0 at its rest state.
@@ -136,6 +144,8 @@ class ProgressiveSimulation {
   bool settled_ = false;
   bool level_converged_ = false;
   int settle_steps_ = 0;
+  /// Newton iterations already taken in the next step before a restore (0: start it afresh).
+  int resumed_iterations_ = 0;
   std::unique_ptr<ShellSystem> coarse_system_;  ///< the current level's system below the finest
   std::unique_ptr<LevelStepper> stepper_;
   Eigen::VectorXd x_;

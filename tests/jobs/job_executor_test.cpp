@@ -22,7 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A solver whose every frame takes a fixed number of "Newton" iterations, each a contraction
-/// x ← x/2 + (frame + level)·1; its results depend on every iteration taken exactly once.
+/// x ← x/2 + (frame + level + drift)·1; its results depend on every iteration taken exactly
+/// once. The drift grows by 1/4 per frame solved and is known only through state(), so a resume
+/// that does not hand the stored state back ends elsewhere.
 class ScriptedSolver final : public jobs::LevelSolver {
  public:
   ScriptedSolver(int levels, int frames, int iterations)
@@ -45,7 +47,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     const int first = std::exchange(resumed_iterations_, 0);
     if (first == 0) previous_ = x_;
     for (int k = first; k < iterations_; ++k) {
-      x_ = 0.5 * x_ + Eigen::VectorXd::Constant(x_.size(), frame + level_);
+      x_ = 0.5 * x_ + Eigen::VectorXd::Constant(x_.size(), frame + level_ + drift_);
       NewtonIteration it;
       it.iteration = k;
       it.step_length = 1.0;
@@ -56,6 +58,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     check.iteration = iterations_;
     progress(frame, check);
     frame_ = frame;
+    drift_ += 0.25;
     jobs::LevelFrame record;
     record.level = level_;
     record.frame = frame;
@@ -72,8 +75,12 @@ class ScriptedSolver final : public jobs::LevelSolver {
   const Eigen::VectorXd& previous() const override { return previous_; }
   const TriMesh& level_rest_mesh() const override { return rest_; }
   Positions finest_positions() const override { return as_positions(x_); }
+  std::map<std::string, double> state() const override { return {{"drift", drift_}}; }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
-               const Eigen::VectorXd& previous, int iterations_in_frame) override {
+               const Eigen::VectorXd& previous, int iterations_in_frame,
+               const std::map<std::string, double>& state) override {
+    const auto drift = state.find("drift");
+    drift_ = drift == state.end() ? 0.0 : drift->second;
     level_ = level;
     x_ = positions;
     previous_ = previous;
@@ -86,6 +93,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
  private:
   int levels_, frames_, iterations_;
   int level_ = 0, frame_ = 0, resumed_iterations_ = 0;
+  double drift_ = 0.0;
   TriMesh rest_;
   Eigen::VectorXd x_, previous_;
 };
@@ -192,11 +200,12 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
     EXPECT_FALSE(fs::exists(run_dir().previous_snapshot(level.level)));
   }
   // Every iteration of every frame of both levels applied once, in order: x ← x/2 + frame +
-  // level, from the rest position 0 of vertex 0.
+  // level + drift, from the rest position 0 of vertex 0.
   double expected = 0.0;
+  double drift = 0.0;
   for (int level = 0; level < 2; ++level)
-    for (int frame = 1; frame <= kFrames; ++frame)
-      for (int k = 0; k < kIterations; ++k) expected = 0.5 * expected + frame + level;
+    for (int frame = 1; frame <= kFrames; ++frame, drift += 0.25)
+      for (int k = 0; k < kIterations; ++k) expected = 0.5 * expected + frame + level + drift;
   const Checkpoint c = final_checkpoint();
   EXPECT_EQ(c.positions(0, 0), expected);
   // The level's checkpoint holds its last frame's energy for the reports.

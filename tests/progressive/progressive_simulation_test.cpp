@@ -2,16 +2,20 @@
 // cylinder scenes (CI size, nested grids) the finest answer matches a direct fine solve and the
 // coarsest preview beats a direct coarse simulation; the step-wise API and resuming.
 
+#include "engine/progressive/progressive_simulation.hpp"
+
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <map>
+#include <optional>
+#include <string>
 
-#include "engine/progressive/progressive_simulation.hpp"
 #include "engine/scene/scene_reader.hpp"
-#include "support/test_paths.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "progressive/nested_cases.hpp"
 #include "progressive/reference_runs.hpp"
+#include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
@@ -171,6 +175,85 @@ TEST(ProgressiveSimulation, RestoreResumesWhereTheStoredStateLeftOff) {
                std::invalid_argument);
   EXPECT_THROW(resumed.restore(1, 4, original.positions(), original.previous()),
                std::invalid_argument);  // level 1 has the fine mesh's unknowns
+}
+
+/// Runs the schedule from the current state to its end.
+void finish(ProgressiveSimulation& sim) {
+  while (true) {
+    run_level(sim);
+    if (sim.finished()) return;
+    sim.refine();
+  }
+}
+
+/// What a checkpoint stores of a progressive run.
+struct StoredState {
+  int level = 0, frame = 0, iterations_in_frame = 0;
+  Eigen::VectorXd positions, previous;
+  std::map<std::string, double> schedule;
+};
+
+StoredState store(const ProgressiveSimulation& sim, int frame, int iterations_in_frame) {
+  return {sim.level(),     frame,          iterations_in_frame,
+          sim.positions(), sim.previous(), sim.schedule_state()};
+}
+
+struct Interrupted {};
+
+TEST(ProgressiveSimulation, ResumingAnyStoredIterateEndsExactlyLikeTheUninterruptedRun) {
+  const test::NestedCase twist = test::nested_case("twist", 4);
+  ProgressiveSettings settings = two_levels(twist.scene);
+  settings.schedule.refine_frame = 2;
+  ProgressiveSimulation uninterrupted(twist.scene, settings, {twist.hierarchy});
+  int steps_taken = 0;  // Newton iterations that moved the iterate, over the whole run
+  std::vector<StoredState> between_steps;
+  while (true) {
+    while (!uninterrupted.level_done()) {
+      uninterrupted.step(
+          [&](int, int, const NewtonIteration& it) { steps_taken += it.step_length > 0; });
+      between_steps.push_back(store(uninterrupted, uninterrupted.frame(), 0));
+    }
+    if (uninterrupted.finished()) break;
+    uninterrupted.refine();
+    between_steps.push_back(store(uninterrupted, uninterrupted.frame(), 0));
+  }
+  ASSERT_GT(steps_taken, 8);
+
+  const auto expect_resumed_run_ends_as_uninterrupted = [&](const StoredState& stored) {
+    ProgressiveSimulation resumed(twist.scene, settings, {twist.hierarchy});
+    resumed.restore(stored.level, stored.frame, stored.positions, stored.previous,
+                    stored.iterations_in_frame, stored.schedule);
+    finish(resumed);
+    EXPECT_LE((resumed.positions() - uninterrupted.positions()).lpNorm<Eigen::Infinity>(), 1e-12);
+  };
+  // Inside steps: preview frames, settling at the refine frame, the finest level's frames.
+  for (const int cut :
+       {1, steps_taken / 4, steps_taken / 2, 3 * steps_taken / 4, steps_taken - 1}) {
+    SCOPED_TRACE(cut);
+    ProgressiveSimulation interrupted(twist.scene, settings, {twist.hierarchy});
+    int taken = 0;
+    std::optional<StoredState> stored;
+    try {
+      while (true) {
+        while (!interrupted.level_done())
+          interrupted.step([&](int, int frame, const NewtonIteration& it) {
+            if (it.step_length <= 0 || ++taken < cut) return;
+            stored = store(interrupted, frame, it.iteration + 1);
+            throw Interrupted{};
+          });
+        if (interrupted.finished()) break;
+        interrupted.refine();
+      }
+    } catch (const Interrupted&) {
+    }
+    ASSERT_TRUE(stored);
+    expect_resumed_run_ends_as_uninterrupted(*stored);
+  }
+  // Between steps, including a level done at the refine frame (no extra settling step).
+  for (const std::size_t k : {std::size_t{0}, between_steps.size() / 2, between_steps.size() - 2}) {
+    SCOPED_TRACE(k);
+    expect_resumed_run_ends_as_uninterrupted(between_steps[k]);
+  }
 }
 
 }  // namespace
