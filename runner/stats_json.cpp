@@ -3,7 +3,9 @@
 namespace psq::runner {
 
 nlohmann::json phase_times_json(const PhaseTimes& t) {
-  return {{"assembly", t.assembly}, {"factorization", t.factorization}, {"solve", t.solve},
+  return {{"assembly", t.assembly},
+          {"factorization", t.factorization},
+          {"solve", t.solve},
           {"line_search", t.line_search}};
 }
 
@@ -24,6 +26,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"gradient_norm", r.newton.gradient_norm},
           {"step_norm_history", step_norms},
           {"gradient_norm_history", gradient_norms},
+          {"friction_iterations", r.friction_iterations},
           {"seconds", r.newton.wall_seconds},
           {"phase_seconds", phase_times_json(r.newton.times)}};
 }

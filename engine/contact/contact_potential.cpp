@@ -43,10 +43,7 @@ double pair_value(const ContactPair& pair, const Eigen::VectorXd& x, const Barri
   const double s = band.barrier_argument(pair_distance(pair, x));
   if (!(s > 0)) return kInfinity;
   const double b = barrier(s, band.barrier_activation());
-  if (!pair.edge_edge || b == 0) return b;
-  const PairPositions p = stencil_positions(pair.vertices, x);
-  const double c = (p[1] - p[0]).cross(p[3] - p[2]).squaredNorm();
-  return edge_edge_mollifier(c, pair.mollifier_threshold) * b;
+  return b == 0 ? b : barrier_weight(pair, x) * b;
 }
 
 /// Value, gradient and Hessian of m b for one pair (κ = 1), by the product rule
@@ -97,6 +94,13 @@ void check_parameters(const ContactParameters& parameters) {
 }
 
 }  // namespace
+
+double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x) {
+  if (!pair.edge_edge) return 1.0;
+  const PairPositions p = stencil_positions(pair.vertices, x);
+  const double c = (p[1] - p[0]).cross(p[3] - p[2]).squaredNorm();
+  return edge_edge_mollifier(c, pair.mollifier_threshold);
+}
 
 ContactStats& ContactStats::operator+=(const ContactStats& other) {
   barrier_evaluations += other.barrier_evaluations;

@@ -62,12 +62,18 @@ struct ContactPair {
   double mollifier_threshold = 0;  ///< ε_x of an edge–edge pair
 };
 
+/// The constant factor of a pair's barrier at x: the edge–edge mollifier m(c(x)) of an edge–edge
+/// pair, 1 for a point–triangle pair (the barrier weight of its normal force, friction.hpp).
+double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x);
+
 class ContactPotential {
  public:
   /// Throws InputError when d̂ is not positive, ξ is negative or a CCD setting is out of range.
   ContactPotential(ContactSurface surface, const ContactParameters& parameters);
 
   [[nodiscard]] const ContactParameters& parameters() const { return parameters_; }
+  /// The bodies and their vertices (vertex_body tells which pair of bodies a pair joins).
+  [[nodiscard]] const ContactSurface& surface() const { return surface_; }
   [[nodiscard]] const BroadPhase& broad_phase() const { return broad_phase_; }
   /// The distance within which pairs interact: ξ + d̂.
   [[nodiscard]] double reach() const;

@@ -2,6 +2,7 @@
 // The scene model: what a scene file describes, after validation. Units SI throughout.
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -30,7 +31,7 @@ struct MeshSource {
 struct VertexSelector {
   enum class Kind { Box, BoundaryLoop, List } kind = Kind::Box;
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  int boundary_loop = 0;   ///< index into the shell's boundary loops, ordered by size, largest first
+  int boundary_loop = 0;  ///< index into the shell's boundary loops, ordered by size, largest first
   std::vector<int> indices;
   /// Where the selector was written (scene file and line; empty / 0 when built in code), so
   /// that a selection that turns out empty on the built mesh can be reported there.
@@ -92,8 +93,16 @@ struct HierarchyOptions {
   /// Preview levels stop when a step changes the solution by less than this (‖Δx‖∞/Δt)
   /// [m/s]. Unset: 10 × the solver tolerance.
   std::optional<double> preview_tolerance;
-  int preview_iterations = 8;  ///< Newton-type iterations per preview step at most
+  int preview_iterations = 8;       ///< Newton-type iterations per preview step at most
   std::optional<int> refine_frame;  ///< the frame where levels are refined; unset: the last
+};
+
+/// A [[contact.pair]] entry: the friction coefficient between two named bodies, overriding
+/// [contact] friction for their contacts.
+struct BodyPairFriction {
+  std::array<std::string, 2>
+      bodies;             ///< shell or collider names; the same name twice: self-contact
+  double friction = 0.0;  ///< μ ≥ 0 between them
 };
 
 /// The [contact] table: IPC contact between shells, shell self-contact and colliders.
@@ -106,6 +115,10 @@ struct ContactSettings {
   double thickness = 0.0;           ///< ξ [m], the offset of the contact surface (≥ 0)
   std::optional<double> stiffness;  ///< κ; unset: IPC's automatic choice and updates
   double friction = 0.0;            ///< μ, the friction coefficient between any two bodies
+  std::vector<BodyPairFriction> pair_friction;  ///< per-pair overrides of `friction`
+  /// ε_v [m per unit time], the tangential speed below which a contact sticks (IPC's static
+  /// friction threshold; ε = ε_v Δt). Unset: 1e-3 × the bounding-box diagonal per unit time.
+  std::optional<double> friction_slip_velocity;
   double ccd_rescaling = 0.9;       ///< s of the additive CCD (fraction of the safe advance)
   double ccd_ratio_bound = 0.1;     ///< r: a CCD step keeps at least r × the initial gap
   int ccd_max_iterations = 10'000;  ///< CCD advances per pair before stopping conservatively

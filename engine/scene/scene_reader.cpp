@@ -212,6 +212,12 @@ class Section {
     } else if constexpr (std::is_same_v<T, std::string>) {
       if (!node.is_string()) wrong_type(key, node, "a string");
       return node.as_string()->get();
+    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      const toml::array* array = node.as_array();
+      if (!array) wrong_type(key, node, "an array of strings");
+      std::vector<std::string> out;
+      for (const toml::node& element : *array) out.push_back(convert<std::string>(key, element));
+      return out;
     } else if constexpr (std::is_same_v<T, std::vector<int>>) {
       const toml::array* array = node.as_array();
       if (!array) wrong_type(key, node, "an array of integers");
@@ -588,19 +594,49 @@ HierarchyOptions read_hierarchy(const Section& root, const TimeStepping& time) {
   return hierarchy;
 }
 
-/// The [contact] table with its optional [contact.ccd] sub-table.
-ContactSettings read_contact(const Section& root) {
+/// A [[contact.pair]]: two body names from `body_names` (shells and colliders) and their μ.
+BodyPairFriction read_pair_friction(const Section& section,
+                                    const std::set<std::string>& body_names) {
+  section.allow_only({"bodies", "friction"});
+  const auto bodies = section.get_required<std::vector<std::string>>("bodies");
+  section.check(bodies.size() == 2, "bodies",
+                fmt::format("a list of two shell or collider names (got {})", bodies.size()));
+  for (const std::string& body : bodies)
+    if (!body_names.contains(body)) {
+      const Keys known(body_names.begin(), body_names.end());
+      const auto suggestion = suggest_key(body, known);
+      section.fail(
+          section.line("bodies"),
+          fmt::format("unknown body '{}' in 'bodies' {}; {}", body, section.where(),
+                      suggestion ? fmt::format("did you mean '{}'?", *suggestion)
+                                 : fmt::format("shells and colliders: {}", quoted_list(known))));
+    }
+  return {{bodies[0], bodies[1]}, read_non_negative(section, "friction", 0.0)};
+}
+
+/// The [contact] table with its optional [contact.ccd] sub-table and [[contact.pair]] list;
+/// pairs name bodies from `body_names`.
+ContactSettings read_contact(const Section& root, const std::set<std::string>& body_names) {
   ContactSettings contact;
   const auto section = root.optional_table("contact");
   if (!section) return contact;
   section->allow_only({"enabled", "self_contact", "activation_distance", "thickness", "stiffness",
-                       "friction", "skip_when_apart", "ccd"});
+                       "friction", "friction_slip_velocity", "pair", "skip_when_apart", "ccd"});
   contact.enabled = section->get_optional<bool>("enabled");
   contact.self_contact = section->get<bool>("self_contact", contact.self_contact);
   contact.activation_distance = read_optional_positive(*section, "activation_distance");
   contact.thickness = read_non_negative(*section, "thickness", contact.thickness);
   contact.stiffness = read_optional_positive(*section, "stiffness");
   contact.friction = read_non_negative(*section, "friction", contact.friction);
+  contact.friction_slip_velocity = read_optional_positive(*section, "friction_slip_velocity");
+  std::set<std::pair<std::string, std::string>> pairs_given;
+  for (const Section& pair : section->tables("pair")) {
+    contact.pair_friction.push_back(read_pair_friction(pair, body_names));
+    const auto& [a, b] = contact.pair_friction.back().bodies;
+    if (!pairs_given.insert(std::minmax(a, b)).second)
+      pair.fail(pair.line("bodies"),
+                fmt::format("the pair '{}', '{}' {} is given twice", a, b, pair.where()));
+  }
   contact.skip_when_apart = section->get<bool>("skip_when_apart", contact.skip_when_apart);
   if (const auto ccd = section->optional_table("ccd")) {
     ccd->allow_only({"rescaling", "ratio_bound", "max_iterations"});
@@ -663,11 +699,11 @@ Scene read_scene(const fs::path& path) {
     scene.shells.push_back(read_shell(shell, path));
     check_unique_name(shell, shell_names, scene.shells.back().name, "shell");
   }
-  scene.contact = read_contact(root);
   for (const Section& collider : root.tables("collider")) {
     scene.colliders.push_back(read_collider(collider, path));
     check_unique_name(collider, shell_names, scene.colliders.back().name, "shell or collider");
   }
+  scene.contact = read_contact(root, shell_names);  // its pairs name shells and colliders
   return scene;
 }
 

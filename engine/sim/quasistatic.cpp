@@ -23,6 +23,9 @@ constexpr int kMaxPullRounds = 6;
 /// them (the solver keeps its objective fixed within a call, so κ may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
+/// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
+constexpr int kMaxFrictionIterations = 5;
+
 /// Adds a solve to a frame's Newton record: iterations, history and times accumulate; the
 /// verdict and the final values are the last solve's.
 void append_solve(NewtonResult& frame, NewtonResult solve) {
@@ -62,6 +65,8 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
   if (contact_enabled(scene)) {
     contact_ = std::make_unique<ContactTerm>(system_);
     potential_.add_term(*contact_);
+    if (friction_enabled(scene))
+      friction_ = std::make_unique<FrictionTerm>(system_, scene.time.step);
   }
 }
 
@@ -135,6 +140,34 @@ NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
   }
 }
 
+void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const NewtonSettings& settings,
+                                                const NewtonSolver::Progress& progress) {
+  if (!friction_) {
+    append_solve(record.newton, solve_with_contact(dofs_, settings, progress));
+    return;
+  }
+  // IPC's outer loop: λ, T and w lagged at xᵗ, then at each solution, until the solution moves
+  // less than the Newton tolerance (the same velocity-like measure) between outer iterations.
+  // Without lagged contacts before and after a solve, re-solving would change nothing.
+  potential_.add_term(*friction_);
+  friction_->lag(contact_->potential(), previous_, previous_);
+  Eigen::VectorXd last_solution;
+  while (true) {
+    const bool had_contacts = friction_->contact_count() > 0;
+    append_solve(record.newton, solve_with_contact(dofs_, settings, progress));
+    ++record.friction_iterations;
+    const bool settled =
+        last_solution.size() == x_.size() &&
+        (x_ - last_solution).lpNorm<Eigen::Infinity>() / settings.step_scale < settings.tolerance;
+    if (!record.newton.converged || settled || record.friction_iterations == kMaxFrictionIterations)
+      break;
+    friction_->lag(contact_->potential(), x_, previous_);
+    if (!had_contacts && friction_->contact_count() == 0) break;
+    last_solution = x_;
+  }
+  potential_.remove_term(*friction_);
+}
+
 void QuasistaticSimulation::finish_contact_frame(FrameRecord& record) {
   Eigen::VectorXd target = x_;
   system_.apply_pins(target, record.time);
@@ -162,7 +195,7 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   if (contact_) {
     begin_contact_frame(record, settings, counted_progress);
-    append_solve(record.newton, solve_with_contact(dofs_, settings, counted_progress));
+    solve_contact_frame(record, settings, counted_progress);
     finish_contact_frame(record);
   } else {
     record.newton = solve_pinned_step(newton_, potential_, system_, dofs_, settings, record.frame,

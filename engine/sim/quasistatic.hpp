@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "engine/sim/contact_term.hpp"
+#include "engine/sim/friction_term.hpp"
 #include "engine/sim/incremental_potential.hpp"
 #include "engine/sim/kinematic_pull.hpp"
 #include "engine/sim/shell_system.hpp"
@@ -36,6 +37,9 @@ struct FrameRecord {
   /// Largest |coordinate| of a scripted vertex's distance from its target at the end [m]: 0
   /// unless the targets could not be reached without intersecting.
   double kinematic_offset = 0;
+  /// Solves of IPC's outer friction loop (friction scenes only; 0 otherwise): friction lagged at
+  /// the frame start, then re-lagged at each solution until the solution settles.
+  int friction_iterations = 0;
 };
 
 /// One quasistatic step without contact, shared by QuasistaticSimulation and the levels of a
@@ -69,6 +73,8 @@ class QuasistaticSimulation {
   [[nodiscard]] const NewtonSettings& newton_settings() const { return settings_; }
   /// The contact term, or null when the scene has no contact.
   [[nodiscard]] ContactTerm* contact() { return contact_.get(); }
+  /// The friction term, or null without contact or when every μ is 0.
+  [[nodiscard]] const FrictionTerm* friction() const { return friction_.get(); }
 
   /// Solves the next frame. A frame that does not converge within the iteration limit is
   /// returned with newton.converged = false; numerical failures throw NumericalError.
@@ -93,12 +99,17 @@ class QuasistaticSimulation {
   /// Newton on x_ over `dofs` in chunks, with IPC's κ update between them (contact scenes).
   NewtonResult solve_with_contact(const DofMap& dofs, const NewtonSettings& settings,
                                   const NewtonSolver::Progress& progress);
+  /// The frame's solve with the scripted vertices fixed: solve_with_contact, inside IPC's outer
+  /// friction loop when the scene has friction.
+  void solve_contact_frame(FrameRecord& record, const NewtonSettings& settings,
+                           const NewtonSolver::Progress& progress);
   /// The frame's contact statistics.
   void finish_contact_frame(FrameRecord& record);
 
   ShellSystem system_;
   IncrementalPotential potential_;
-  std::unique_ptr<ContactTerm> contact_;  ///< null when the scene has no contact
+  std::unique_ptr<ContactTerm> contact_;    ///< null when the scene has no contact
+  std::unique_ptr<FrictionTerm> friction_;  ///< null without contact or friction
   KinematicPull pull_;
   DofMap dofs_;
   NewtonSolver newton_;

@@ -521,8 +521,13 @@ activation_distance = 2e-3
 thickness = 1e-4
 stiffness = 1e5
 friction = 0.4
+friction_slip_velocity = 2e-4
 skip_when_apart = false
 ccd = { rescaling = 0.8, ratio_bound = 0.999, max_iterations = 500 }
+
+[[contact.pair]]
+bodies = ["cloth", "ball"]
+friction = 0.1
 
 [[collider]]
 name = "ball"
@@ -545,6 +550,11 @@ translation = [0, 0, -0.2]
   EXPECT_EQ(contact.thickness, 1e-4);
   EXPECT_EQ(contact.stiffness, std::optional<double>(1e5));
   EXPECT_EQ(contact.friction, 0.4);
+  EXPECT_EQ(contact.friction_slip_velocity, std::optional<double>(2e-4));
+  ASSERT_EQ(contact.pair_friction.size(), 1u);  // names a collider given further down
+  EXPECT_EQ(contact.pair_friction[0].bodies[0], "cloth");
+  EXPECT_EQ(contact.pair_friction[0].bodies[1], "ball");
+  EXPECT_EQ(contact.pair_friction[0].friction, 0.1);
   EXPECT_FALSE(contact.skip_when_apart);
   EXPECT_EQ(contact.ccd_rescaling, 0.8);
   EXPECT_EQ(contact.ccd_ratio_bound, 0.999);
@@ -571,6 +581,8 @@ TEST(ReadScene, ContactDefaultsLeaveTheChoicesToTheSimulation) {
   EXPECT_FALSE(scene.contact.stiffness.has_value());
   EXPECT_EQ(scene.contact.thickness, 0.0);
   EXPECT_EQ(scene.contact.friction, 0.0);
+  EXPECT_TRUE(scene.contact.pair_friction.empty());
+  EXPECT_FALSE(scene.contact.friction_slip_velocity.has_value());
   EXPECT_TRUE(scene.contact.skip_when_apart);
   EXPECT_EQ(scene.contact.ccd_rescaling, defaults.ccd_rescaling);
   EXPECT_EQ(scene.contact.ccd_ratio_bound, defaults.ccd_ratio_bound);
@@ -587,6 +599,18 @@ TEST(ReadScene, BadContactAndColliderEntriesNameTheirFileLineAndKey) {
       {"[contact]\nfriction = -0.1", 6, "'friction' in [contact]"},
       {"[contact]\nself_contact = 1", 6, "true or false"},
       {"[contact]\nfrcition = 0.3", 6, "did you mean 'friction'?"},
+      {"[contact]\nfriction_slip_velocity = 0", 6, "'friction_slip_velocity' in [contact]"},
+      {"[[contact.pair]]\nbodies = [\"cloth\", \"clth\"]\nfriction = 0.2", 6,
+       "unknown body 'clth' in 'bodies' in [contact.pair]; did you mean 'cloth'?"},
+      {"[[contact.pair]]\nbodies = [\"cloth\"]", 6, "'bodies' in [contact.pair] must be a list of two"},
+      {"[[contact.pair]]\nbodies = [\"cloth\", 3]", 6, "expected a string for 'bodies'"},
+      {"[[contact.pair]]\nbodies = [\"cloth\", \"cloth\"]\nfriction = -1", 7,
+       "'friction' in [contact.pair]"},
+      {"[[contact.pair]]\nbodies = [\"cloth\", \"cloth\"]\nmu = 1", 7,
+       "unknown key 'mu' in [contact.pair]"},
+      {"[[contact.pair]]\nbodies = [\"cloth\", \"cloth\"]\n[[contact.pair]]\nbodies = "
+       "[\"cloth\", \"cloth\"]",
+       8, "is given twice"},
       {"[contact]\nccd = { ratio_bound = 1.5 }", 6, "'ratio_bound' in [contact.ccd]"},
       {"[contact]\nccd = { max_iterations = 0 }", 6, "'max_iterations' in [contact.ccd]"},
       {"[[collider]]\nname = \"ball\"", 5, "missing required table 'mesh' in [collider]"},

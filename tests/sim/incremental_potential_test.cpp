@@ -1,6 +1,6 @@
 // Finite-difference checks of the whole quasistatic objective (inertia, membrane, bending,
-// gravity and loads) on a curved unstructured mesh, and with the contact barrier between two
-// sheets in near contact, through the solver's own assembly.
+// gravity and loads) on a curved unstructured mesh, and with the contact barrier and lagged
+// friction between two sheets in near contact, through the solver's own assembly.
 
 #include "engine/sim/incremental_potential.hpp"
 
@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "engine/sim/contact_term.hpp"
+#include "engine/sim/friction_term.hpp"
 #include "engine/solver/sparse_assembler.hpp"
 #include "support/finite_difference.hpp"
 
@@ -178,6 +179,68 @@ TEST_F(ContactPotentialTest, SolverHessianWithContactIsPositiveSemiDefinite) {
   potential_.hessian(x_, blocks);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_GE(smallest_eigenvalue(hessian), -1e-9 * hessian.norm());
+}
+
+/// The stacked sheets with friction (μ = 0.4, ε = ε_v Δt = 1e-5 m), lagged at the contact state
+/// x for a step from xᵗ = x minus tangential slips of up to 2ε: contacts on both sides of ε.
+class FrictionObjectiveTest : public ::testing::Test {
+ protected:
+  static Scene scene() {
+    Scene s = stacked_sheets_scene();
+    s.contact.friction = 0.4;
+    s.contact.friction_slip_velocity = 1e-3;
+    return s;
+  }
+  FrictionObjectiveTest()
+      : system_(scene()), potential_(system_, 0.01), contact_(system_), friction_(system_, 0.01) {
+    const Eigen::VectorXd rest = flat(system_.rest_mesh().vertices);
+    std::srand(11);
+    x_ = rest;
+    Eigen::VectorXd previous = rest;
+    for (Eigen::Index v = 0; v < x_.size() / 3; ++v) {
+      x_[3 * v + 2] += 1.5e-4 * Eigen::VectorXd::Random(1)[0];
+      previous.segment<2>(3 * v) -= 2e-5 * Eigen::Vector2d::Random();
+    }
+    potential_.set_previous(previous);
+    potential_.add_term(contact_);
+    potential_.add_term(friction_);
+    friction_.lag(contact_.potential(), x_, previous);
+  }
+  ShellSystem system_;
+  IncrementalPotential potential_;
+  ContactTerm contact_;
+  FrictionTerm friction_;
+  Eigen::VectorXd x_;
+};
+
+TEST_F(FrictionObjectiveTest, FrictionIsASignificantPartOfTheGradient) {
+  ASSERT_GT(friction_.contact_count(), 10);
+  Eigen::VectorXd without_friction = Eigen::VectorXd::Zero(x_.size());
+  Eigen::VectorXd friction_only = Eigen::VectorXd::Zero(x_.size());
+  potential_.base_gradient(x_, without_friction);
+  contact_.add_gradient(x_, without_friction);
+  friction_.add_gradient(x_, friction_only);
+  EXPECT_GT(friction_only.norm(), 0.01 * without_friction.norm());
+}
+
+TEST_F(FrictionObjectiveTest, GradientMatchesFiniteDifferences) {
+  Eigen::VectorXd g;
+  potential_.gradient(x_, g);
+  const Eigen::VectorXd fd =
+      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-9);
+  EXPECT_LT(test::relative_error(g, fd), 1e-5);
+}
+
+TEST_F(FrictionObjectiveTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
+  HessianBlocks blocks;
+  potential_.hessian(x_, blocks);  // the diagonal, the friction blocks and the batch layout
+  for (std::size_t s = 0; s < 2; ++s) {
+    system_.membranes()[s].hessian(x_, blocks.batches[2 * s], false);
+    system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
+  }
+  contact_.potential().hessian(x_, blocks.batches[4], false);
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-9)), 1e-4);
 }
 
 }  // namespace
