@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/elastic/bending_model.hpp"
 #include "engine/elastic/material.hpp"
 #include "engine/mesh/generators.hpp"
 
@@ -70,6 +71,7 @@ struct Shell {
   std::string name;
   MeshSource mesh;
   Material material;
+  BendingModel bending = BendingModel::hinge;  ///< the `bending` key
   std::vector<PinnedSet> pins;
   std::vector<Load> loads;
 };

@@ -244,7 +244,8 @@ void check_direction(const Section& section, std::string_view key, const Eigen::
   section.check(axis.norm() > 0, key, "a nonzero direction (got [0, 0, 0])");
 }
 
-/// One of `choices` as written for `key`, suggesting the nearest one on a typo.
+/// One of `choices` as written for `key`. Anything else fails listing the choices, with the
+/// nearest one suggested on a typo.
 std::string read_choice(const Section& section, std::string_view key, const Keys& choices,
                         std::optional<std::string> fallback = std::nullopt) {
   const std::string value =
@@ -252,9 +253,9 @@ std::string read_choice(const Section& section, std::string_view key, const Keys
   if (std::find(choices.begin(), choices.end(), value) != choices.end()) return value;
   const auto suggestion = suggest_key(value, choices);
   section.fail(section.line(key),
-               fmt::format("unknown {} '{}' {}; {}", key, value, section.where(),
-                           suggestion ? fmt::format("did you mean '{}'?", *suggestion)
-                                      : fmt::format("expected one of {}", quoted_list(choices))));
+               fmt::format("unknown {} '{}' {}; {}expected one of {}", key, value, section.where(),
+                           suggestion ? fmt::format("did you mean '{}'? ", *suggestion) : "",
+                           quoted_list(choices)));
 }
 
 // Checked numbers: each reads `key` and fails naming its requirement and the value given.
@@ -436,6 +437,13 @@ Material read_material(const Section& shell) {
   return material;
 }
 
+/// The shell's `bending` key: "hinge" (the default) or "midedge".
+BendingModel read_bending_model(const Section& shell) {
+  return read_choice(shell, "bending", {"hinge", "midedge"}, "hinge") == "midedge"
+             ? BendingModel::midedge
+             : BendingModel::hinge;
+}
+
 const Keys kSelectorKeys = {"box", "boundary_loop", "vertices"};
 
 /// Keys of a table that also holds a vertex selector.
@@ -536,11 +544,12 @@ void check_unique_name(const Section& section, std::set<std::string>& used, cons
 }
 
 Shell read_shell(const Section& section, const fs::path& scene_path) {
-  section.allow_only({"name", "mesh", "placement", "material", "pin", "load"});
+  section.allow_only({"name", "mesh", "placement", "material", "bending", "pin", "load"});
   Shell shell;
   shell.name = read_name(section);
   shell.mesh = read_mesh_source(section, scene_path);
   shell.material = read_material(section);
+  shell.bending = read_bending_model(section);
   std::set<std::string> pin_names;
   for (const Section& pin : section.tables("pin")) {
     shell.pins.push_back(read_pin(pin));

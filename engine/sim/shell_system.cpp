@@ -150,7 +150,7 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
     rest_.triangles.middleRows(block.first_triangle, block.triangle_count) =
         mesh.triangles.array() + block.first_vertex;
     membranes_.emplace_back(mesh, shell.material, block.first_vertex);
-    bendings_.emplace_back(mesh, block.topology, shell.material, block.first_vertex);
+    bendings_.emplace_back(shell.bending, mesh, block.topology, shell.material, block.first_vertex);
 
     const Eigen::VectorXd mass = lumped_vertex_masses(mesh, shell.material);
     for (int v = 0; v < block.vertex_count; ++v) {

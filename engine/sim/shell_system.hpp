@@ -5,8 +5,8 @@
 #include <memory>
 #include <vector>
 
-#include "engine/elastic/bending.hpp"
 #include "engine/elastic/membrane.hpp"
+#include "engine/elastic/shell_bending.hpp"
 #include "engine/mesh/topology.hpp"
 #include "engine/scene/scene.hpp"
 
@@ -65,7 +65,8 @@ class ShellSystem {
   /// The colliders, whose vertices and triangles follow the shells' in rest_mesh().
   [[nodiscard]] const std::vector<ColliderBlock>& colliders() const { return colliders_; }
   [[nodiscard]] const std::vector<MembraneEnergy>& membranes() const { return membranes_; }
-  [[nodiscard]] const std::vector<BendingEnergy>& bendings() const { return bendings_; }
+  /// Per shell, its bending energy in the model the scene chose for it.
+  [[nodiscard]] const std::vector<ShellBending>& bendings() const { return bendings_; }
   /// Lumped mass per DOF (3n).
   [[nodiscard]] const Eigen::VectorXd& dof_masses() const { return dof_masses_; }
   /// Constant external force per DOF (3n): gravity and loads.
@@ -90,7 +91,7 @@ class ShellSystem {
   std::vector<ShellBlock> shells_;
   std::vector<ColliderBlock> colliders_;
   std::vector<MembraneEnergy> membranes_;
-  std::vector<BendingEnergy> bendings_;
+  std::vector<ShellBending> bendings_;
   Eigen::VectorXd dof_masses_;
   Eigen::VectorXd external_force_;
   std::vector<PinnedVertex> pinned_;

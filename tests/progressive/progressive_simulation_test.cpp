@@ -108,6 +108,14 @@ TEST(ProgressiveSimulation, TwistMatchesDirectFineAndPreviewBeatsDirectCoarse) {
   compare_with_direct_solves(twist);
 }
 
+TEST(ProgressiveSimulation, MidedgeDrapeMatchesDirectFineAndPreviewBeatsDirectCoarse) {
+  // Every level's system bends with the scene's model: the coarse level's mid-edge faces in the
+  // preview and Hessian, the finest level's in the proxy's energy and gradient.
+  test::NestedCase drape = test::nested_case("drape", 10);
+  drape.scene.shells[0].bending = BendingModel::midedge;
+  compare_with_direct_solves(drape);
+}
+
 TEST(ProgressiveSimulation, CylinderMatchesDirectFineAndPreviewBeatsDirectCoarse) {
   // The decimated hierarchy (build_hierarchy) of the library's can at ~400 fine vertices.
   Scene scene = read_scene(test::source_dir() / "jobs" / "scenes" / "cylinder_compress.toml");

@@ -84,6 +84,7 @@ force = [1, 0, 0]
 name = "ball"
 mesh = { generator = "sphere", radius = 0.3, edge_length = 0.03 }
 material = { youngs_modulus = 1e5, poisson_ratio = -0.5, density = 100, thickness = 2e-3 }
+bending = "midedge"
 
 [[shell]]
 name = "imported"
@@ -134,6 +135,7 @@ TEST(ReadScene, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(plate.material.poisson_ratio, 0.25);
   EXPECT_EQ(plate.material.density, 450);
   EXPECT_EQ(plate.material.thickness, 7.5e-4);
+  EXPECT_EQ(plate.bending, BendingModel::hinge);
 
   ASSERT_EQ(plate.pins.size(), 2u);
   const PinnedSet& edge = plate.pins[0];
@@ -193,6 +195,7 @@ TEST(ReadScene, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(ball.mesh.sphere.edge_length, 0.03);
   EXPECT_EQ(ball.material.poisson_ratio, -0.5);
   EXPECT_EQ(ball.material.thickness, 2e-3);
+  EXPECT_EQ(ball.bending, BendingModel::midedge);
 
   const Shell& imported = scene.shells[3];
   EXPECT_EQ(imported.mesh.kind, MeshSource::Kind::File);
@@ -220,6 +223,7 @@ material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness
   ASSERT_EQ(scene.shells.size(), 1u);
   EXPECT_FALSE(scene.shells[0].mesh.sheet.structured);
   EXPECT_TRUE(scene.shells[0].mesh.sheet.holes.empty());
+  EXPECT_EQ(scene.shells[0].bending, BendingModel::hinge);
   EXPECT_TRUE(scene.shells[0].pins.empty());
   EXPECT_TRUE(scene.shells[0].loads.empty());
 }
@@ -368,6 +372,16 @@ const std::vector<BadCase> kBadCases = {
     {"zero_placement_axis", 8,
      "name = \"sheet\"\nplacement = { rotation_axis = [0, 0, 0], rotation_degrees = 90 }",
      9, {"'rotation_axis' in [shell.placement]", "nonzero"}},
+    {"misspelt_bending_model", 8,
+     "name = \"sheet\"\nbending = \"midege\"",
+     9, {"unknown bending 'midege' in [shell]", "did you mean 'midedge'?",
+         "expected one of 'hinge', 'midedge'"}},
+    {"unknown_bending_model", 8,
+     "name = \"sheet\"\nbending = \"discrete shells\"",
+     9, {"unknown bending 'discrete shells' in [shell]", "expected one of 'hinge', 'midedge'"}},
+    {"bending_in_material", 10,
+     R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, bending = "hinge" })",
+     10, {"unknown key 'bending' in [shell.material]"}},
     {"zero_scale", 8,
      "name = \"sheet\"\nplacement = { scale = 0 }",
      9, {"'scale' in [shell.placement]", "positive"}},

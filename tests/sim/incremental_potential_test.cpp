@@ -1,6 +1,7 @@
 // Finite-difference checks of the whole quasistatic objective (inertia, membrane, bending,
-// gravity and loads) on a curved unstructured mesh, and with the contact barrier and lagged
-// friction between two sheets in near contact, through the solver's own assembly.
+// gravity and loads) on a curved unstructured mesh with either bending model, and with the
+// contact barrier and lagged friction between two sheets in near contact, through the solver's
+// own assembly.
 
 #include "engine/sim/incremental_potential.hpp"
 
@@ -39,7 +40,7 @@ double smallest_eigenvalue(const Eigen::MatrixXd& symmetric) {
 }
 
 /// An open cylinder (curved rest shape, non-zero rest angles) with gravity and a point load.
-Scene curved_scene() {
+Scene curved_scene(BendingModel bending) {
   Scene scene;
   scene.source = "curved-test";
   scene.gravity = {0.0, 0.0, -9.81};
@@ -49,6 +50,7 @@ Scene curved_scene() {
   shell.mesh.kind = MeshSource::Kind::Cylinder;
   shell.mesh.cylinder = {0.05, 0.06, 0.02};
   shell.material = {2e5, 0.35, 500.0, 1e-3};
+  shell.bending = bending;
   Load load;
   load.selector.kind = VertexSelector::Kind::List;
   load.selector.indices = {0, 3};
@@ -58,9 +60,9 @@ Scene curved_scene() {
   return scene;
 }
 
-class IncrementalPotentialTest : public ::testing::Test {
+class IncrementalPotentialTest : public ::testing::TestWithParam<BendingModel> {
  protected:
-  IncrementalPotentialTest() : system_(curved_scene()), potential_(system_, 0.01) {
+  IncrementalPotentialTest() : system_(curved_scene(GetParam())), potential_(system_, 0.01) {
     const Eigen::VectorXd rest = flat(system_.rest_mesh().vertices);
     std::srand(7);
     potential_.set_previous(rest + 2e-3 * Eigen::VectorXd::Random(rest.size()));
@@ -71,7 +73,7 @@ class IncrementalPotentialTest : public ::testing::Test {
   Eigen::VectorXd x_;
 };
 
-TEST_F(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
+TEST_P(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
   Eigen::VectorXd g;
   potential_.gradient(x_, g);
   const Eigen::VectorXd fd =
@@ -79,7 +81,7 @@ TEST_F(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
   EXPECT_LT(test::relative_error(g, fd), 1e-6);
 }
 
-TEST_F(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
+TEST_P(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);  // the diagonal (inertia) and the batch layout
   system_.membranes()[0].hessian(x_, blocks.batches[0], false);
@@ -88,14 +90,14 @@ TEST_F(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDiffere
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-7)), 1e-5);
 }
 
-TEST_F(IncrementalPotentialTest, SolverHessianIsPositiveSemiDefinite) {
+TEST_P(IncrementalPotentialTest, SolverHessianIsPositiveSemiDefinite) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_GE(smallest_eigenvalue(hessian), -1e-9 * hessian.norm());
 }
 
-TEST_F(IncrementalPotentialTest, ExternalForceIsGravityPlusLoads) {
+TEST_P(IncrementalPotentialTest, ExternalForceIsGravityPlusLoads) {
   const Eigen::VectorXd& f = system_.external_force();
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
   for (Eigen::Index v = 0; v < f.size() / 3; ++v) total += f.segment<3>(3 * v);
@@ -107,8 +109,20 @@ TEST_F(IncrementalPotentialTest, ExternalForceIsGravityPlusLoads) {
   EXPECT_NEAR(mass / (500.0 * 1e-3 * 2 * M_PI * 0.05 * 0.06), 1.0, 0.02);
 }
 
+TEST_P(IncrementalPotentialTest, BendingIsTheScenesModel) {
+  EXPECT_EQ(system_.bendings()[0].model(), GetParam());
+  EXPECT_GT(potential_.elastic_energy(x_), system_.membranes()[0].value(x_));
+}
+
+INSTANTIATE_TEST_SUITE_P(BendingModels, IncrementalPotentialTest,
+                         ::testing::Values(BendingModel::hinge, BendingModel::midedge),
+                         [](const ::testing::TestParamInfo<BendingModel>& info) {
+                           return info.param == BendingModel::hinge ? "hinge" : "midedge";
+                         });
+
 /// Two 3 cm sheets (1 cm structured edges), the upper one 0.6 d̂ above the lower and shifted
-/// sideways, with a fixed barrier stiffness.
+/// sideways, with a fixed barrier stiffness. The upper one bends with the mid-edge model, so the
+/// assembly holds both models' blocks side by side.
 Scene stacked_sheets_scene() {
   Scene scene;
   scene.source = "contact-test";
@@ -120,6 +134,7 @@ Scene stacked_sheets_scene() {
     shell.mesh.sheet = {0.03, 0.03, 0.01, {}, true};
     shell.mesh.translation = k == 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.003, 0.004, 6e-4);
     shell.material = {1e5, 0.3, 500.0, 1e-3};
+    shell.bending = k == 0 ? BendingModel::hinge : BendingModel::midedge;
     scene.shells.push_back(shell);
   }
   scene.contact.activation_distance = 1e-3;

@@ -1,11 +1,14 @@
 // The cantilever strip of jobs/scenes/cantilever.toml with mid-edge bending instead of hinges,
 // solved statically, against Euler–Bernoulli beam theory: δ = F L³ / (3 E I), I = b h³/12.
 //
-// The system is built by hand (membrane + mid-edge bending − f·x, pinned clamp) because the
-// simulation still uses hinge bending. With ν = 0 a plate strip and a beam agree exactly. With
-// ν > 0 a strip this narrow (Searle's parameter b²/(R h) ≈ 0.02 ≪ 1 at this load) bends like a
-// beam, E I, with free anticlastic curvature; only next to the clamp, which forbids that
-// curvature, is it stiffer, towards the plate value D b = E I/(1 − ν²).
+// The system is built by hand (membrane + mid-edge bending − f·x, pinned clamp) so that both
+// splits and several resolutions can be compared; scenes choose the halves split with
+// `bending = "midedge"` (tests/sim/cantilever_test.cpp runs the scene itself).
+//
+// With ν = 0 a plate strip and a beam agree exactly. With ν > 0 a strip this narrow (Searle's
+// parameter b²/(R h) ≈ 0.02 ≪ 1 at this load) bends like a beam, E I, with free anticlastic
+// curvature; only next to the clamp, which forbids that curvature, is it stiffer, towards the
+// plate value D b = E I/(1 − ν²).
 
 #include <gtest/gtest.h>
 
