@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "engine/core/error.hpp"
+#include "engine/sim/strain_limit_term.hpp"
 
 namespace psq {
 namespace {
@@ -30,8 +31,14 @@ void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
                      *s.refine_frame));
   if (!scene.colliders.empty() || scene.contact.enabled.value_or(false) ||
       scene.contact.self_contact)
-    fail("progressive simulation handles scenes without contact only (no [[collider]], "
-         "[contact] off); contact-safe refinement is not implemented yet");
+    fail(
+        "progressive simulation handles scenes without contact only (no [[collider]], "
+        "[contact] off); contact-safe refinement is not implemented yet");
+  if (strain_limit_enabled(scene))
+    fail(
+        "progressive simulation handles scenes without strain limits only (no 'strain_limit' "
+        "in a shell's material); the level proxies do not carry the barrier yet, so run such "
+        "scenes with levels = 1");
   if (settings.max_settle_steps < 1)
     fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
 }
@@ -82,8 +89,8 @@ void ProgressiveSimulation::initialize() {
     level_count_ = std::max(level_count_, hierarchies_[s].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
-  finest_tolerance_ = scene.solver.tolerance.value_or(
-      1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
+  finest_tolerance_ =
+      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
@@ -99,10 +106,10 @@ void ProgressiveSimulation::build_prolongations() {
       const int here = shell_level(h, level, level_count_);
       const int next = shell_level(h, level + 1, level_count_);
       const TriMesh& rest = h.levels[here].rest;
-      finest_maps.push_back(here + 1 == h.level_count()
-                                ? identity_prolongation(rest)
-                                : ShellProlongation(rest, h.levels[here].finest,
-                                                    h.finest().rest.vertices));
+      finest_maps.push_back(
+          here + 1 == h.level_count()
+              ? identity_prolongation(rest)
+              : ShellProlongation(rest, h.levels[here].finest, h.finest().rest.vertices));
       next_maps.push_back(next == here ? identity_prolongation(rest)
                                        : ShellProlongation(rest, h.levels[here].next_finer,
                                                            h.levels[next].rest.vertices));
@@ -210,15 +217,16 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
   const int last_frame = level + 1 < level_count_ ? refine_frame_ : frame_count();
   const int first_frame = level == 0 ? 0 : refine_frame_;
   if (frame < first_frame || frame > last_frame)
-    throw std::invalid_argument(fmt::format(
-        "ProgressiveSimulation::restore: frame {} is outside level {}'s frames {}..{}", frame,
-        level, first_frame, last_frame));
+    throw std::invalid_argument(
+        fmt::format("ProgressiveSimulation::restore: frame {} is outside level {}'s frames {}..{}",
+                    frame, level, first_frame, last_frame));
   enter_level(level);
   const Eigen::Index size = level_system().rest_mesh().vertices.size();
   if (positions.size() != size || previous.size() != size)
     throw std::invalid_argument(fmt::format(
         "ProgressiveSimulation::restore: level {} has {} unknowns, got {} positions and {} "
-        "previous", level, size, positions.size(), previous.size()));
+        "previous",
+        level, size, positions.size(), previous.size()));
   x_ = positions;
   previous_ = previous;
   frame_ = frame;

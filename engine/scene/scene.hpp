@@ -30,7 +30,7 @@ struct MeshSource {
 struct VertexSelector {
   enum class Kind { Box, BoundaryLoop, List } kind = Kind::Box;
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  int boundary_loop = 0;   ///< index into the shell's boundary loops, ordered by size, largest first
+  int boundary_loop = 0;  ///< index into the shell's boundary loops, ordered by size, largest first
   std::vector<int> indices;
   /// Where the selector was written (scene file and line; empty / 0 when built in code), so
   /// that a selection that turns out empty on the built mesh can be reported there.
@@ -65,10 +65,21 @@ struct Load {
   Eigen::Vector3d total_force = Eigen::Vector3d::Zero();  ///< [N]
 };
 
+/// A shell's strain limit (the `strain_limit` keys of its material table): no principal
+/// stretch of any of its triangles may reach `limit` (C-IPC strain limiting,
+/// docs/friction-and-strain-limiting.md).
+struct StrainLimitSettings {
+  double limit = 1.05;  ///< s̄ > 1, the largest principal stretch approached
+  /// κ_s [N/m] to start from (doubled while the barrier loses); unset: E h δ²
+  /// (initial_strain_limit_stiffness).
+  std::optional<double> stiffness;
+};
+
 struct Shell {
   std::string name;
   MeshSource mesh;
   Material material;
+  std::optional<StrainLimitSettings> strain_limit;  ///< none: the shell stretches freely
   std::vector<PinnedSet> pins;
   std::vector<Load> loads;
 };
@@ -92,7 +103,7 @@ struct HierarchyOptions {
   /// Preview levels stop when a step changes the solution by less than this (‖Δx‖∞/Δt)
   /// [m/s]. Unset: 10 × the solver tolerance.
   std::optional<double> preview_tolerance;
-  int preview_iterations = 8;  ///< Newton-type iterations per preview step at most
+  int preview_iterations = 8;       ///< Newton-type iterations per preview step at most
   std::optional<int> refine_frame;  ///< the frame where levels are refined; unset: the last
 };
 

@@ -19,8 +19,9 @@ constexpr double kInitialPullStiffness = 1e4;
 constexpr double kPullGrowth = 100.0;
 constexpr int kMaxPullRounds = 6;
 
-/// With contact, Newton runs in chunks of this many iterations with IPC's κ update between
-/// them (the solver keeps its objective fixed within a call, so κ may only change between).
+/// With contact or strain limits, Newton runs in chunks of this many iterations with the κ and
+/// κ_s updates between them (the solver keeps its objective fixed within a call, so stiffnesses
+/// may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
 /// Adds a solve to a frame's Newton record: iterations, history and times accumulate; the
@@ -34,18 +35,26 @@ void append_solve(NewtonResult& frame, NewtonResult solve) {
   frame = std::move(solve);
 }
 
+/// Moves the pinned vertices of x to their scripted positions at frame·Δt; throws
+/// NumericalError when that makes `objective` non-finite.
+void apply_pins_checked(Objective& objective, const ShellSystem& system, int frame,
+                        Eigen::VectorXd& x) {
+  system.apply_pins(x, frame * system.scene().time.step);
+  if (!std::isfinite(objective.value(x)))
+    throw NumericalError(fmt::format(
+        "frame {}: moving the pinned vertices to their scripted positions inverts, degenerates "
+        "or stretches to the strain limit triangles next to them; use more frames (smaller "
+        "steps of the motion)",
+        frame));
+}
+
 }  // namespace
 
 NewtonResult solve_pinned_step(NewtonSolver& newton, Objective& objective,
                                const ShellSystem& system, const DofMap& dofs,
                                const NewtonSettings& settings, int frame, Eigen::VectorXd& x,
                                const NewtonSolver::Progress& progress) {
-  system.apply_pins(x, frame * system.scene().time.step);
-  if (!std::isfinite(objective.value(x)))
-    throw NumericalError(fmt::format(
-        "frame {}: moving the pinned vertices to their scripted positions inverts or "
-        "degenerates triangles next to them; use more frames (smaller steps of the motion)",
-        frame));
+  apply_pins_checked(objective, system, frame, x);
   return newton.minimize(objective, x, dofs, settings, progress);
 }
 
@@ -62,6 +71,11 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
   if (contact_enabled(scene)) {
     contact_ = std::make_unique<ContactTerm>(system_);
     potential_.add_term(*contact_);
+  }
+  if (strain_limit_enabled(scene)) {
+    strain_limit_ = std::make_unique<StrainLimitTerm>(system_);
+    strain_limit_->require_feasible(x_, "the rest state");
+    potential_.add_term(*strain_limit_);
   }
 }
 
@@ -94,7 +108,7 @@ void QuasistaticSimulation::begin_contact_frame(FrameRecord& record, const Newto
   const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
   pull_.set_stiffness(kInitialPullStiffness);
   for (int round = 0; round < kMaxPullRounds; ++round) {
-    append_solve(record.newton, solve_with_contact(pulled_dofs, settings, progress));
+    append_solve(record.newton, solve_in_chunks(pulled_dofs, settings, progress));
     ++record.kinematic_rounds;
     if (move_scripted_vertices_if_safe(record.time)) break;
     pull_.set_stiffness(kPullGrowth * pull_.stiffness());
@@ -113,9 +127,11 @@ bool QuasistaticSimulation::move_scripted_vertices_if_safe(double time) {
   return true;
 }
 
-NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
-                                                       const NewtonSettings& settings,
-                                                       const NewtonSolver::Progress& progress) {
+NewtonResult QuasistaticSimulation::solve_in_chunks(const DofMap& dofs,
+                                                    const NewtonSettings& settings,
+                                                    const NewtonSolver::Progress& progress) {
+  const int interval =
+      contact_ || strain_limit_ ? kStiffnessUpdateInterval : settings.max_iterations;
   NewtonResult total;
   int done = 0;
   const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
@@ -126,13 +142,18 @@ NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
   };
   NewtonSettings chunk = settings;
   while (true) {
-    chunk.max_iterations = std::min(kStiffnessUpdateInterval, settings.max_iterations - done);
+    chunk.max_iterations = std::min(interval, settings.max_iterations - done);
     NewtonResult part = newton_.minimize(potential_, x_, dofs, chunk, numbered);
     done += part.iterations;
     append_solve(total, std::move(part));
     if (total.converged || done >= settings.max_iterations) return total;
-    contact_->update_stiffness(x_);
+    update_stiffnesses();
   }
+}
+
+void QuasistaticSimulation::update_stiffnesses() {
+  if (contact_) contact_->update_stiffness(x_);
+  if (strain_limit_) strain_limit_->update_stiffness(x_);
 }
 
 void QuasistaticSimulation::finish_contact_frame(FrameRecord& record) {
@@ -162,11 +183,11 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   if (contact_) {
     begin_contact_frame(record, settings, counted_progress);
-    append_solve(record.newton, solve_with_contact(dofs_, settings, counted_progress));
+    append_solve(record.newton, solve_in_chunks(dofs_, settings, counted_progress));
     finish_contact_frame(record);
   } else {
-    record.newton = solve_pinned_step(newton_, potential_, system_, dofs_, settings, record.frame,
-                                      x_, counted_progress);
+    apply_pins_checked(potential_, system_, record.frame, x_);
+    record.newton = solve_in_chunks(dofs_, settings, counted_progress);
   }
   record.newton.iterations += resumed_iterations;
   frame_ = record.frame;
@@ -186,6 +207,9 @@ void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
   if (iterations_in_frame < 0 || iterations_in_frame > settings_.max_iterations)
     throw std::invalid_argument(fmt::format("restore: {} iterations done, the limit is {}",
                                             iterations_in_frame, settings_.max_iterations));
+  if (strain_limit_)
+    strain_limit_->require_feasible(positions,
+                                    fmt::format("the restored state of frame {}", frame));
   x_ = positions;
   previous_ = previous;
   frame_ = in_progress ? frame - 1 : frame;
