@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "engine/core/error.hpp"
+#include "engine/sim/strain_limit_term.hpp"
 
 namespace psq {
 namespace {
@@ -41,6 +42,11 @@ void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
     fail(
         "progressive simulation handles scenes without contact only (no [[collider]], "
         "[contact] off); contact-safe refinement is not implemented yet");
+  if (strain_limit_enabled(scene))
+    fail(
+        "progressive simulation handles scenes without strain limits only (no 'strain_limit' "
+        "in a shell's material); the level proxies do not carry the barrier yet, so run such "
+        "scenes with levels = 1");
   if (settings.max_settle_steps < 1)
     fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
 }

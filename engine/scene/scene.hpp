@@ -67,11 +67,22 @@ struct Load {
   Eigen::Vector3d total_force = Eigen::Vector3d::Zero();  ///< [N]
 };
 
+/// A shell's strain limit (the `strain_limit` keys of its material table): no principal
+/// stretch of any of its triangles may reach `limit` (C-IPC strain limiting,
+/// docs/friction-and-strain-limiting.md).
+struct StrainLimitSettings {
+  double limit = 1.05;  ///< s̄ > 1, the largest principal stretch approached
+  /// κ_s [N/m] to start from (doubled while the barrier loses); unset: E h δ²
+  /// (initial_strain_limit_stiffness).
+  std::optional<double> stiffness;
+};
+
 struct Shell {
   std::string name;
   MeshSource mesh;
   Material material;
   BendingModel bending = BendingModel::hinge;  ///< the `bending` key
+  std::optional<StrainLimitSettings> strain_limit;  ///< none: the shell stretches freely
   std::vector<PinnedSet> pins;
   std::vector<Load> loads;
 };

@@ -424,9 +424,9 @@ MeshSource read_mesh_source(const Section& shell, const fs::path& scene_path) {
 // ---------------------------------------------------------------------------------------------
 // Materials, selectors, pins, loads
 
-Material read_material(const Section& shell) {
-  const Section section = shell.table("material");
-  section.allow_only({"youngs_modulus", "poisson_ratio", "density", "thickness"});
+Material read_material(const Section& section) {
+  section.allow_only({"youngs_modulus", "poisson_ratio", "density", "thickness", "strain_limit",
+                      "strain_limit_stiffness"});
   Material material;
   material.youngs_modulus = read_positive(section, "youngs_modulus");
   material.poisson_ratio = section.get_required<double>("poisson_ratio");
@@ -442,6 +442,23 @@ BendingModel read_bending_model(const Section& shell) {
   return read_choice(shell, "bending", {"hinge", "midedge"}, "hinge") == "midedge"
              ? BendingModel::midedge
              : BendingModel::hinge;
+}
+
+/// The material table's optional strain limit: `strain_limit` > 1 (a stretch; 1 is the rest
+/// length) and, with it only, a positive `strain_limit_stiffness`.
+std::optional<StrainLimitSettings> read_strain_limit(const Section& material) {
+  if (!material.has("strain_limit")) {
+    material.check(!material.has("strain_limit_stiffness"), "strain_limit_stiffness",
+                   "given together with 'strain_limit'");
+    return std::nullopt;
+  }
+  StrainLimitSettings limit;
+  limit.limit = material.get_required<double>("strain_limit");
+  material.check(limit.limit > 1, "strain_limit",
+                 fmt::format("greater than 1, a principal stretch above the rest length (got {:g})",
+                             limit.limit));
+  limit.stiffness = read_optional_positive(material, "strain_limit_stiffness");
+  return limit;
 }
 
 const Keys kSelectorKeys = {"box", "boundary_loop", "vertices"};
@@ -548,7 +565,9 @@ Shell read_shell(const Section& section, const fs::path& scene_path) {
   Shell shell;
   shell.name = read_name(section);
   shell.mesh = read_mesh_source(section, scene_path);
-  shell.material = read_material(section);
+  const Section material = section.table("material");
+  shell.material = read_material(material);
+  shell.strain_limit = read_strain_limit(material);
   shell.bending = read_bending_model(section);
   std::set<std::string> pin_names;
   for (const Section& pin : section.tables("pin")) {

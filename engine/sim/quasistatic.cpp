@@ -19,8 +19,9 @@ constexpr double kInitialPullStiffness = 1e4;
 constexpr double kPullGrowth = 100.0;
 constexpr int kMaxPullRounds = 6;
 
-/// With contact, Newton runs in chunks of this many iterations with IPC's κ update between
-/// them (the solver keeps its objective fixed within a call, so κ may only change between).
+/// With contact or strain limits, Newton runs in chunks of this many iterations with the κ and
+/// κ_s updates between them (the solver keeps its objective fixed within a call, so stiffnesses
+/// may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
 /// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
@@ -37,18 +38,26 @@ void append_solve(NewtonResult& frame, NewtonResult solve) {
   frame = std::move(solve);
 }
 
+/// Moves the pinned vertices of x to their scripted positions at frame·Δt; throws
+/// NumericalError when that makes `objective` non-finite.
+void apply_pins_checked(Objective& objective, const ShellSystem& system, int frame,
+                        Eigen::VectorXd& x) {
+  system.apply_pins(x, frame * system.scene().time.step);
+  if (!std::isfinite(objective.value(x)))
+    throw NumericalError(fmt::format(
+        "frame {}: moving the pinned vertices to their scripted positions inverts, degenerates "
+        "or stretches to the strain limit triangles next to them; use more frames (smaller "
+        "steps of the motion)",
+        frame));
+}
+
 }  // namespace
 
 NewtonResult solve_pinned_step(NewtonSolver& newton, Objective& objective,
                                const ShellSystem& system, const DofMap& dofs,
                                const NewtonSettings& settings, int frame, Eigen::VectorXd& x,
                                const NewtonSolver::Progress& progress) {
-  system.apply_pins(x, frame * system.scene().time.step);
-  if (!std::isfinite(objective.value(x)))
-    throw NumericalError(fmt::format(
-        "frame {}: moving the pinned vertices to their scripted positions inverts or "
-        "degenerates triangles next to them; use more frames (smaller steps of the motion)",
-        frame));
+  apply_pins_checked(objective, system, frame, x);
   return newton.minimize(objective, x, dofs, settings, progress);
 }
 
@@ -67,6 +76,11 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
     potential_.add_term(*contact_);
     if (friction_enabled(scene))
       friction_ = std::make_unique<FrictionTerm>(system_, scene.time.step);
+  }
+  if (strain_limit_enabled(scene)) {
+    strain_limit_ = std::make_unique<StrainLimitTerm>(system_);
+    strain_limit_->require_feasible(x_, "the rest state");
+    potential_.add_term(*strain_limit_);
   }
 }
 
@@ -99,7 +113,7 @@ void QuasistaticSimulation::begin_contact_frame(FrameRecord& record, const Newto
   const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
   pull_.set_stiffness(kInitialPullStiffness);
   for (int round = 0; round < kMaxPullRounds; ++round) {
-    append_solve(record.newton, solve_with_contact(pulled_dofs, settings, progress));
+    append_solve(record.newton, solve_in_chunks(pulled_dofs, settings, progress));
     ++record.kinematic_rounds;
     if (move_scripted_vertices_if_safe(record.time)) break;
     pull_.set_stiffness(kPullGrowth * pull_.stiffness());
@@ -118,9 +132,11 @@ bool QuasistaticSimulation::move_scripted_vertices_if_safe(double time) {
   return true;
 }
 
-NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
-                                                       const NewtonSettings& settings,
-                                                       const NewtonSolver::Progress& progress) {
+NewtonResult QuasistaticSimulation::solve_in_chunks(const DofMap& dofs,
+                                                    const NewtonSettings& settings,
+                                                    const NewtonSolver::Progress& progress) {
+  const int interval =
+      contact_ || strain_limit_ ? kStiffnessUpdateInterval : settings.max_iterations;
   NewtonResult total;
   int done = 0;
   const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
@@ -131,19 +147,19 @@ NewtonResult QuasistaticSimulation::solve_with_contact(const DofMap& dofs,
   };
   NewtonSettings chunk = settings;
   while (true) {
-    chunk.max_iterations = std::min(kStiffnessUpdateInterval, settings.max_iterations - done);
+    chunk.max_iterations = std::min(interval, settings.max_iterations - done);
     NewtonResult part = newton_.minimize(potential_, x_, dofs, chunk, numbered);
     done += part.iterations;
     append_solve(total, std::move(part));
     if (total.converged || done >= settings.max_iterations) return total;
-    contact_->update_stiffness(x_);
+    update_stiffnesses();
   }
 }
 
 void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const NewtonSettings& settings,
                                                 const NewtonSolver::Progress& progress) {
   if (!friction_) {
-    append_solve(record.newton, solve_with_contact(dofs_, settings, progress));
+    append_solve(record.newton, solve_in_chunks(dofs_, settings, progress));
     return;
   }
   // IPC's outer loop: λ, T and w lagged at xᵗ, then at each solution, until the solution moves
@@ -154,7 +170,7 @@ void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const Newto
   Eigen::VectorXd last_solution;
   while (true) {
     const bool had_contacts = friction_->contact_count() > 0;
-    append_solve(record.newton, solve_with_contact(dofs_, settings, progress));
+    append_solve(record.newton, solve_in_chunks(dofs_, settings, progress));
     ++record.friction_iterations;
     const bool settled =
         last_solution.size() == x_.size() &&
@@ -166,6 +182,11 @@ void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const Newto
     last_solution = x_;
   }
   potential_.remove_term(*friction_);
+}
+
+void QuasistaticSimulation::update_stiffnesses() {
+  if (contact_) contact_->update_stiffness(x_);
+  if (strain_limit_) strain_limit_->update_stiffness(x_);
 }
 
 void QuasistaticSimulation::finish_contact_frame(FrameRecord& record) {
@@ -198,8 +219,8 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
     solve_contact_frame(record, settings, counted_progress);
     finish_contact_frame(record);
   } else {
-    record.newton = solve_pinned_step(newton_, potential_, system_, dofs_, settings, record.frame,
-                                      x_, counted_progress);
+    apply_pins_checked(potential_, system_, record.frame, x_);
+    record.newton = solve_in_chunks(dofs_, settings, counted_progress);
   }
   record.newton.iterations += resumed_iterations;
   frame_ = record.frame;
@@ -219,6 +240,9 @@ void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
   if (iterations_in_frame < 0 || iterations_in_frame > settings_.max_iterations)
     throw std::invalid_argument(fmt::format("restore: {} iterations done, the limit is {}",
                                             iterations_in_frame, settings_.max_iterations));
+  if (strain_limit_)
+    strain_limit_->require_feasible(positions,
+                                    fmt::format("the restored state of frame {}", frame));
   x_ = positions;
   previous_ = previous;
   frame_ = in_progress ? frame - 1 : frame;

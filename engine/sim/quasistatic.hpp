@@ -8,6 +8,10 @@
 // toward the targets by a penalty of growing stiffness (KinematicPull) while the CCD line search
 // keeps every iterate intersection-free, and they are pinned at the targets as soon as the rest
 // of the way is safe. The frame's solve follows with them fixed.
+//
+// With strain limits (docs/friction-and-strain-limiting.md), no accepted iterate stretches a
+// limited shell's triangle to its limit: the line search starts from the barrier's feasible
+// step, and κ_s adapts between Newton chunks as κ does with contact.
 
 #include <functional>
 #include <memory>
@@ -17,6 +21,7 @@
 #include "engine/sim/incremental_potential.hpp"
 #include "engine/sim/kinematic_pull.hpp"
 #include "engine/sim/shell_system.hpp"
+#include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/newton.hpp"
 
 namespace psq {
@@ -59,6 +64,7 @@ class QuasistaticSimulation {
   using Progress = std::function<void(int frame, const NewtonIteration&)>;
 
   /// Builds the shell system of `scene` and starts at its rest state.
+  /// @throws InputError when the rest state is not strictly below a shell's strain limit.
   explicit QuasistaticSimulation(const Scene& scene);
 
   [[nodiscard]] const ShellSystem& system() const { return system_; }
@@ -75,6 +81,8 @@ class QuasistaticSimulation {
   [[nodiscard]] ContactTerm* contact() { return contact_.get(); }
   /// The friction term, or null without contact or when every μ is 0.
   [[nodiscard]] const FrictionTerm* friction() const { return friction_.get(); }
+  /// The strain-limit term, or null when no shell sets a strain limit.
+  [[nodiscard]] StrainLimitTerm* strain_limit() { return strain_limit_.get(); }
 
   /// Solves the next frame. A frame that does not converge within the iteration limit is
   /// returned with newton.converged = false; numerical failures throw NumericalError.
@@ -85,7 +93,8 @@ class QuasistaticSimulation {
   /// step() solves frame + 1 from it). Otherwise frame `frame` is in progress: `positions` is its
   /// Newton iterate after `iterations_in_frame` iterations, and the next step() continues that
   /// solve with xᵗ = `previous` and the iterations left of solver.max_iterations.
-  /// @throws std::invalid_argument when the sizes or the frame do not fit this simulation.
+  /// @throws std::invalid_argument when the sizes or the frame do not fit this simulation;
+  /// InputError when `positions` is not strictly below a shell's strain limit.
   void restore(int frame, const Eigen::VectorXd& positions, const Eigen::VectorXd& previous,
                int iterations_in_frame = 0);
 
@@ -96,10 +105,13 @@ class QuasistaticSimulation {
   /// Moves every scripted vertex to its target at `time` if that motion (the others held) is
   /// intersection-free by the CCD and the energy stays finite; returns whether it moved.
   bool move_scripted_vertices_if_safe(double time);
-  /// Newton on x_ over `dofs` in chunks, with IPC's κ update between them (contact scenes).
-  NewtonResult solve_with_contact(const DofMap& dofs, const NewtonSettings& settings,
-                                  const NewtonSolver::Progress& progress);
-  /// The frame's solve with the scripted vertices fixed: solve_with_contact, inside IPC's outer
+  /// Newton on x_ over `dofs`; with adaptive stiffnesses (contact κ, strain-limit κ_s) in
+  /// chunks, with update_stiffnesses between them.
+  NewtonResult solve_in_chunks(const DofMap& dofs, const NewtonSettings& settings,
+                               const NewtonSolver::Progress& progress);
+  /// IPC's κ update and Codim-IPC's κ_s update at x_, for the terms the scene has.
+  void update_stiffnesses();
+  /// The frame's solve with the scripted vertices fixed: solve_in_chunks, inside IPC's outer
   /// friction loop when the scene has friction.
   void solve_contact_frame(FrameRecord& record, const NewtonSettings& settings,
                            const NewtonSolver::Progress& progress);
@@ -108,8 +120,9 @@ class QuasistaticSimulation {
 
   ShellSystem system_;
   IncrementalPotential potential_;
-  std::unique_ptr<ContactTerm> contact_;    ///< null when the scene has no contact
-  std::unique_ptr<FrictionTerm> friction_;  ///< null without contact or friction
+  std::unique_ptr<ContactTerm> contact_;           ///< null when the scene has no contact
+  std::unique_ptr<FrictionTerm> friction_;         ///< null without contact or friction
+  std::unique_ptr<StrainLimitTerm> strain_limit_;  ///< null when no shell sets a strain limit
   KinematicPull pull_;
   DofMap dofs_;
   NewtonSolver newton_;

@@ -1,6 +1,7 @@
 #include "engine/sim/shell_system.hpp"
 
 #include <fmt/format.h>
+
 #include <set>
 #include <stdexcept>
 
@@ -20,7 +21,9 @@ std::vector<double> line_load_weights(const TriMesh& mesh, const MeshTopology& t
                                       const std::vector<int>& selected) {
   const std::set<int> chosen(selected.begin(), selected.end());
   std::vector<double> weight(selected.size(), 0.0);
-  auto slot = [&](int v) { return std::lower_bound(selected.begin(), selected.end(), v) - selected.begin(); };
+  auto slot = [&](int v) {
+    return std::lower_bound(selected.begin(), selected.end(), v) - selected.begin();
+  };
   for (const auto& loop : topo.boundary_loops)
     for (std::size_t k = 0; k < loop.size(); ++k) {
       const int a = loop[k];
@@ -64,10 +67,13 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
       double total = 0.0;
       for (double w : weight) total += w;
       if (total <= 0.0)
-        throw InputError(fmt::format("{}: {} is a line load but selects no boundary edge (both ends "
-                                     "of an edge must be selected)", scene_.source.string(), what));
+        throw InputError(
+            fmt::format("{}: {} is a line load but selects no boundary edge (both ends "
+                        "of an edge must be selected)",
+                        scene_.source.string(), what));
       for (std::size_t k = 0; k < selected.size(); ++k)
-        external_force_.segment<3>(3 * (block.first_vertex + selected[k])) += load.total_force * weight[k] / total;
+        external_force_.segment<3>(3 * (block.first_vertex + selected[k])) +=
+            load.total_force * weight[k] / total;
     }
   }
   // A vertex pinned by two sets keeps the first one's motion.
@@ -94,8 +100,10 @@ ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& 
       const int group = shells[s].pin_group[v];
       if (group < 0) continue;
       if (group >= static_cast<int>(pins.size()))
-        throw std::invalid_argument(fmt::format("ShellSystem: pin group {} of shell '{}' does not "
-                                                "exist", group, scene_.shells[s].name));
+        throw std::invalid_argument(
+            fmt::format("ShellSystem: pin group {} of shell '{}' does not "
+                        "exist",
+                        group, scene_.shells[s].name));
       pinned_.push_back({shells_[s].first_vertex + v, meshes[s].vertices.row(v).transpose(),
                          &pins[group].motions, group});
     }
@@ -107,9 +115,9 @@ void ShellSystem::add_colliders() {
   for (const Collider& collider : scene_.colliders) {
     TriMesh mesh = build_shell_mesh(collider.mesh);
     validate_mesh(mesh, fmt::format("{}: collider '{}'", scene_.source.string(), collider.name));
-    ColliderBlock block{collider.name,           rest_.vertex_count(),
-                        mesh.vertex_count(),     rest_.triangle_count(),
-                        mesh.triangle_count(),   MeshTopology::build(mesh, collider.name)};
+    ColliderBlock block{collider.name,         rest_.vertex_count(),
+                        mesh.vertex_count(),   rest_.triangle_count(),
+                        mesh.triangle_count(), MeshTopology::build(mesh, collider.name)};
     rest_.vertices.conservativeResize(block.first_vertex + block.vertex_count, 3);
     rest_.triangles.conservativeResize(block.first_triangle + block.triangle_count, 3);
     rest_.vertices.bottomRows(block.vertex_count) = mesh.vertices;
@@ -118,8 +126,8 @@ void ShellSystem::add_colliders() {
     dof_masses_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
     external_force_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
     for (int v = 0; v < block.vertex_count; ++v)
-      pinned_.push_back({block.first_vertex + v, mesh.vertices.row(v).transpose(),
-                         &collider.motions, -1});
+      pinned_.push_back(
+          {block.first_vertex + v, mesh.vertices.row(v).transpose(), &collider.motions, -1});
     colliders_.push_back(std::move(block));
   }
 }
@@ -129,7 +137,11 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
   for (std::size_t s = 0; s < meshes.size(); ++s) {
     const TriMesh& mesh = meshes[s];
     const std::string& name = scene_.shells[s].name;
-    ShellBlock block{name, vertices, mesh.vertex_count(), triangles, mesh.triangle_count(),
+    ShellBlock block{name,
+                     vertices,
+                     mesh.vertex_count(),
+                     triangles,
+                     mesh.triangle_count(),
                      MeshTopology::build(mesh, name)};
     vertices += block.vertex_count;
     triangles += block.triangle_count;
@@ -161,6 +173,15 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
   }
 }
 
+TriMesh ShellSystem::shell_rest_mesh(int shell) const {
+  const ShellBlock& block = shells_.at(shell);
+  TriMesh mesh;
+  mesh.vertices = rest_.vertices.middleRows(block.first_vertex, block.vertex_count);
+  mesh.triangles = rest_.triangles.middleRows(block.first_triangle, block.triangle_count).array() -
+                   block.first_vertex;
+  return mesh;
+}
+
 std::vector<int> ShellSystem::pinned_vertex_indices() const {
   std::vector<int> out;
   out.reserve(pinned_.size());
@@ -179,7 +200,8 @@ std::vector<int> ShellSystem::pin_groups(int shell) const {
 }
 
 void ShellSystem::apply_pins(Eigen::VectorXd& x, double time) const {
-  for (const PinnedVertex& p : pinned_) x.segment<3>(3 * p.vertex) = apply_motions(*p.motions, p.rest, time);
+  for (const PinnedVertex& p : pinned_)
+    x.segment<3>(3 * p.vertex) = apply_motions(*p.motions, p.rest, time);
 }
 
 }  // namespace psq

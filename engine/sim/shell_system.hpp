@@ -62,6 +62,9 @@ class ShellSystem {
   [[nodiscard]] const Scene& scene() const { return scene_; }
   [[nodiscard]] const TriMesh& rest_mesh() const { return rest_; }
   [[nodiscard]] const std::vector<ShellBlock>& shells() const { return shells_; }
+  /// Shell `shell`'s rest mesh in its own vertex numbering (local vertex i is global vertex
+  /// shells()[shell].first_vertex + i).
+  [[nodiscard]] TriMesh shell_rest_mesh(int shell) const;
   /// The colliders, whose vertices and triangles follow the shells' in rest_mesh().
   [[nodiscard]] const std::vector<ColliderBlock>& colliders() const { return colliders_; }
   [[nodiscard]] const std::vector<MembraneEnergy>& membranes() const { return membranes_; }

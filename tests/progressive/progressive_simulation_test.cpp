@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/core/error.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "progressive/nested_cases.hpp"
@@ -49,6 +50,17 @@ TEST(ProgressiveSimulation, OneLevelIsExactlyTheQuasistaticSimulation) {
     EXPECT_TRUE(progressive.finest_positions() == direct.positions());
   }
   EXPECT_EQ(progressive.frame(), twist.scene.time.frames);
+}
+
+TEST(ProgressiveSimulation, RefusesAStrainLimitedSceneNamingTheKey) {
+  const Scene scene = read_scene(test::source_dir() / "jobs/scenes/hanging_sheet.toml");
+  try {
+    ProgressiveSimulation sim(scene, two_levels(scene), {});
+    FAIL() << "a scene with a strain limit was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'strain_limit'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("levels = 1"), std::string::npos) << e.what();
+  }
 }
 
 /// Runs `sim` (two levels) through, then a direct fine solve and a direct solve of the coarsest

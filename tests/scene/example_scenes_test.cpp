@@ -86,6 +86,18 @@ TEST(ExampleScenes, DrapeHangsAOneMetreClothByTwoCorners) {
   }
 }
 
+TEST(ExampleScenes, HangingSheetIsUprightLimitedAndPinnedAlongItsTopEdge) {
+  const Scene scene = example("hanging_sheet");
+  ASSERT_EQ(scene.shells.size(), 1u);
+  ASSERT_TRUE(scene.shells[0].strain_limit);
+  EXPECT_EQ(scene.shells[0].strain_limit->limit, 1.05);
+  const BuiltShell shell = build(scene)[0];
+  EXPECT_LT(shell.mesh.vertices.col(1).cwiseAbs().maxCoeff(), 1e-12);  // in the xz plane
+  const std::vector<int>& top = shell.pins.at("top");
+  EXPECT_EQ(top.size(), 11u);  // the whole top row of the 2 cm grid
+  for (int v : top) EXPECT_NEAR(shell.mesh.vertices(v, 2), 0.1, 1e-12);
+}
+
 TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonHalfATurn) {
   const Scene scene = example("twist");
   ASSERT_EQ(scene.shells.size(), 1u);
@@ -187,8 +199,10 @@ TEST(ExampleScenes, TwistWrapTurnsBothEndsInOppositeDirectionsWithSelfContact) {
   EXPECT_NEAR(left.z(), 0.5, 1e-9);
   EXPECT_NEAR(right.z(), -0.5, 1e-9);
   // At the end, a full turn each, the ends are back in place, 5 cm further in.
-  EXPECT_LT((apply_motions(sheet.pins[0].motions, {-0.5, 0.5, 0}, end) -
-             Eigen::Vector3d(-0.45, 0.5, 0)).norm(), 1e-9);
+  EXPECT_LT(
+      (apply_motions(sheet.pins[0].motions, {-0.5, 0.5, 0}, end) - Eigen::Vector3d(-0.45, 0.5, 0))
+          .norm(),
+      1e-9);
 }
 
 TEST(ExampleScenes, CylinderCrushIsAThinAluminiumCanUnderADescendingPlate) {

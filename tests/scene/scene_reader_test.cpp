@@ -226,6 +226,29 @@ material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness
   EXPECT_EQ(scene.shells[0].bending, BendingModel::hinge);
   EXPECT_TRUE(scene.shells[0].pins.empty());
   EXPECT_TRUE(scene.shells[0].loads.empty());
+  EXPECT_FALSE(scene.shells[0].strain_limit);
+}
+
+TEST(ReadScene, ReadsAStrainLimitWithAndWithoutItsStiffness) {
+  const fs::path dir = test::fresh_temp_dir("read_scene_strain_limit");
+  const fs::path path = test::write_file(dir / "limited.toml", R"([[shell]]
+name = "given"
+mesh = { generator = "sheet", width = 1, height = 1, edge_length = 0.1 }
+material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limit = 1.1, strain_limit_stiffness = 2.5 }
+
+[[shell]]
+name = "automatic"
+mesh = { generator = "sheet", width = 1, height = 1, edge_length = 0.1 }
+material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limit = 1.02 }
+)");
+  const Scene scene = read_scene(path);
+  ASSERT_EQ(scene.shells.size(), 2u);
+  ASSERT_TRUE(scene.shells[0].strain_limit);
+  EXPECT_EQ(scene.shells[0].strain_limit->limit, 1.1);
+  EXPECT_EQ(scene.shells[0].strain_limit->stiffness, 2.5);
+  ASSERT_TRUE(scene.shells[1].strain_limit);
+  EXPECT_EQ(scene.shells[1].strain_limit->limit, 1.02);
+  EXPECT_FALSE(scene.shells[1].strain_limit->stiffness);
 }
 
 TEST(ReadScene, EmptyListsOfTablesAreAllowed) {
@@ -342,6 +365,18 @@ const std::vector<BadCase> kBadCases = {
     {"zero_thickness", 10,
      R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 0 })",
      10, {"'thickness'", "positive"}},
+    {"strain_limit_not_above_one", 10,
+     R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limit = 1 })",
+     10, {"'strain_limit' in [shell.material]", "greater than 1", "got 1"}},
+    {"strain_limit_stiffness_alone", 10,
+     R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limit_stiffness = 2 })",
+     10, {"'strain_limit_stiffness' in [shell.material]", "together with 'strain_limit'"}},
+    {"zero_strain_limit_stiffness", 10,
+     R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limit = 1.1, strain_limit_stiffness = 0 })",
+     10, {"'strain_limit_stiffness' in [shell.material]", "positive"}},
+    {"misspelt_strain_limit", 10,
+     R"(material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness = 1e-3, strain_limt = 1.1 })",
+     10, {"unknown key 'strain_limt' in [shell.material]", "did you mean 'strain_limit'?"}},
     {"zero_step", 3, "step = 0", 3, {"'step' in [time]", "positive"}},
     {"zero_frames", 4, "frames = 0", 4, {"'frames' in [time]", "at least 1"}},
     {"zero_edge_length", 9,
@@ -527,7 +562,8 @@ material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 200, thickness
 
 TEST(ReadScene, ReadsContactSettingsAndCollidersAsWritten) {
   const fs::path dir = test::fresh_temp_dir("read_contact");
-  const Scene scene = read_scene(test::write_file(dir / "contact.toml", std::string(kShellLines) + R"(
+  const Scene scene =
+      read_scene(test::write_file(dir / "contact.toml", std::string(kShellLines) + R"(
 [contact]
 enabled = true
 self_contact = true
@@ -640,15 +676,16 @@ TEST(ReadScene, BadContactAndColliderEntriesNameTheirFileLineAndKey) {
   };
   int index = 0;
   for (const auto& [text, line, fragment] : cases) {
-    const fs::path path =
-        test::write_file(dir / fmt::format("case{}.toml", index++), std::string(kShellLines) + text + "\n");
+    const fs::path path = test::write_file(dir / fmt::format("case{}.toml", index++),
+                                           std::string(kShellLines) + text + "\n");
     try {
       read_scene(path);
       ADD_FAILURE() << "no error for:\n" << text;
     } catch (const InputError& e) {
       const std::string message = e.what();
       EXPECT_EQ(message.rfind(fmt::format("{}:{}: ", path.string(), line), 0), 0u) << message;
-      EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "'" << fragment << "' not in: " << message;
     }
   }
 }
@@ -662,7 +699,8 @@ TEST(ReadScene, ReadsTheHierarchyTableAndItsDefaults) {
   EXPECT_EQ(plain.hierarchy.preview_iterations, 8);
   EXPECT_FALSE(plain.hierarchy.refine_frame.has_value());
 
-  const Scene scene = read_scene(test::write_file(dir / "hierarchy.toml", std::string(kShellLines) + R"(
+  const Scene scene =
+      read_scene(test::write_file(dir / "hierarchy.toml", std::string(kShellLines) + R"(
 [time]
 frames = 12
 [hierarchy]
@@ -692,7 +730,8 @@ TEST(ReadScene, BadHierarchyEntriesNameTheirFileLineAndKey) {
   };
   int index = 0;
   for (const auto& [line, fragment] : cases) {
-    const std::string text = std::string(kShellLines) + "[time]\nframes = 3\n[hierarchy]\n" + line + "\n";
+    const std::string text =
+        std::string(kShellLines) + "[time]\nframes = 3\n[hierarchy]\n" + line + "\n";
     const fs::path path = test::write_file(dir / fmt::format("case{}.toml", index++), text);
     try {
       read_scene(path);
@@ -700,7 +739,8 @@ TEST(ReadScene, BadHierarchyEntriesNameTheirFileLineAndKey) {
     } catch (const InputError& e) {
       const std::string message = e.what();
       EXPECT_EQ(message.rfind(fmt::format("{}:8: ", path.string()), 0), 0u) << message;
-      EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "'" << fragment << "' not in: " << message;
     }
   }
 }

@@ -1,7 +1,7 @@
 // Finite-difference checks of the whole quasistatic objective (inertia, membrane, bending,
-// gravity and loads) on a curved unstructured mesh with either bending model, and with the
-// contact barrier and lagged friction between two sheets in near contact, through the solver's
-// own assembly.
+// gravity and loads) on a curved unstructured mesh with either bending model, with the contact
+// barrier and lagged friction between two sheets in near contact, and with the strain-limit
+// barriers of two stretched sheets, through the solver's own assembly.
 
 #include "engine/sim/incremental_potential.hpp"
 
@@ -11,6 +11,7 @@
 
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/friction_term.hpp"
+#include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/sparse_assembler.hpp"
 #include "support/finite_difference.hpp"
 
@@ -256,6 +257,99 @@ TEST_F(FrictionObjectiveTest, UnprojectedAssembledHessianMatchesFiniteDifference
   contact_.potential().hessian(x_, blocks.batches[4], false);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-9)), 1e-4);
+}
+
+/// Two 3 cm sheets (1 cm structured edges) side by side, limited to stretches of 1.05 and 1.08,
+/// with a κ_s that makes the barrier dominate the membrane at a few percent of stretch.
+Scene limited_sheets_scene() {
+  Scene scene = stacked_sheets_scene();
+  scene.shells[1].mesh.translation = {0.05, 0.0, 0.0};
+  scene.shells[0].strain_limit = StrainLimitSettings{.limit = 1.05, .stiffness = 1.0};
+  scene.shells[1].strain_limit = StrainLimitSettings{.limit = 1.08, .stiffness = 1.0};
+  return scene;
+}
+
+/// rest with every x coordinate scaled by `stretch`: a uniform stretch of every triangle.
+Eigen::VectorXd stretched_along_x(const ShellSystem& system, double stretch) {
+  Eigen::VectorXd x = flat(system.rest_mesh().vertices);
+  for (Eigen::Index v = 0; v < x.size() / 3; ++v) x[3 * v] *= stretch;
+  return x;
+}
+
+class StrainLimitPotentialTest : public ::testing::Test {
+ protected:
+  StrainLimitPotentialTest()
+      : system_(limited_sheets_scene()), potential_(system_, 0.01), strain_limit_(system_) {
+    potential_.add_term(strain_limit_);
+    std::srand(3);
+    potential_.set_previous(flat(system_.rest_mesh().vertices));
+    // A 3 % stretch with noise of 2e-5 m (0.2 % of an edge): every triangle inside both bands.
+    x_ = stretched_along_x(system_, 1.03) +
+         2e-5 * Eigen::VectorXd::Random(system_.dof_masses().size());
+  }
+  ShellSystem system_;
+  IncrementalPotential potential_;
+  StrainLimitTerm strain_limit_;
+  Eigen::VectorXd x_;
+};
+
+TEST_F(StrainLimitPotentialTest,
+       EveryLimitedShellHasItsBarrierAndItIsASignificantPartOfTheGradient) {
+  ASSERT_EQ(strain_limit_.energies().size(), 2u);
+  EXPECT_GT(strain_limit_.value(x_), 0.0);
+  Eigen::VectorXd base, full;
+  potential_.base_gradient(x_, base);
+  potential_.gradient(x_, full);
+  EXPECT_GT((full - base).norm(), 0.1 * base.norm());
+}
+
+TEST_F(StrainLimitPotentialTest, GradientMatchesFiniteDifferences) {
+  Eigen::VectorXd g;
+  potential_.gradient(x_, g);
+  const Eigen::VectorXd fd =
+      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-8);
+  EXPECT_LT(test::relative_error(g, fd), 1e-6);
+}
+
+// The barrier's Hessian is PSD as it stands (docs/friction-and-strain-limiting.md), so the
+// term's own (projected) blocks are its exact Hessian; membrane and bending are unprojected.
+TEST_F(StrainLimitPotentialTest, AssembledHessianMatchesFiniteDifferences) {
+  HessianBlocks blocks;
+  potential_.hessian(x_, blocks);
+  ASSERT_EQ(blocks.batches[4].element_count(),
+            static_cast<std::size_t>(system_.rest_mesh().triangle_count()));
+  for (std::size_t s = 0; s < 2; ++s) {
+    system_.membranes()[s].hessian(x_, blocks.batches[2 * s], false);
+    system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
+  }
+  const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
+  EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-8)), 1e-5);
+}
+
+TEST_F(StrainLimitPotentialTest, FeasibleStepStopsShortOfTheTightestShellsLimit) {
+  // Stretching on by 5 % more: shell 0 reaches 1.05 at α = 0.4, shell 1 reaches 1.08 at 1. The
+  // step stops at 0.9 × 0.4, where shell 0 keeps a tenth of its slack.
+  const Eigen::VectorXd x = stretched_along_x(system_, 1.03);
+  const Eigen::VectorXd dx = stretched_along_x(system_, 1.08) - x;
+  const double step = potential_.max_feasible_step(x, dx);
+  EXPECT_NEAR(step, 0.9 * (1.05 - 1.03) / (1.08 - 1.03), 1e-9);
+  EXPECT_NEAR(strain_limit_.energies()[0].min_slack(x + step * dx), 0.1 * (1.05 - 1.03), 1e-9);
+  // A step that reaches no limit is not cut.
+  EXPECT_EQ(potential_.max_feasible_step(x, 0.3 * dx), 1.0);
+}
+
+TEST_F(StrainLimitPotentialTest, StiffnessDoublesOnlyForAShellHeldAtItsLimit) {
+  // 2e-6 below shell 0's limit, under its doubling slack 1e-4 δ = 5e-6; far from shell 1's.
+  const Eigen::VectorXd tight = stretched_along_x(system_, 1.05 - 2e-6);
+  strain_limit_.update_stiffness(tight);  // the first call has no previous slack
+  EXPECT_EQ(strain_limit_.energies()[0].stiffness(), 1.0);
+  strain_limit_.update_stiffness(tight);
+  strain_limit_.update_stiffness(tight);
+  EXPECT_EQ(strain_limit_.energies()[0].stiffness(), 4.0);
+  EXPECT_EQ(strain_limit_.energies()[1].stiffness(), 1.0);
+  // Once the slack opens again the stiffness stays.
+  strain_limit_.update_stiffness(stretched_along_x(system_, 1.03));
+  EXPECT_EQ(strain_limit_.energies()[0].stiffness(), 4.0);
 }
 
 }  // namespace
