@@ -9,6 +9,22 @@ nlohmann::json phase_times_json(const PhaseTimes& t) {
           {"line_search", t.line_search}};
 }
 
+nlohmann::json contact_json(const FrameRecord& r) {
+  const ContactStats& c = r.contact;
+  return {{"barrier_stiffness", r.barrier_stiffness},
+          {"kinematic_rounds", r.kinematic_rounds},
+          {"kinematic_offset", r.kinematic_offset},
+          {"max_active_pairs", c.max_active_pairs},
+          {"barrier_evaluations", c.barrier_evaluations},
+          {"barrier_skips", c.barrier_skips},
+          {"ccd_evaluations", c.ccd_evaluations},
+          {"ccd_skips", c.ccd_skips},
+          {"ccd_pair_queries", c.ccd_pair_queries},
+          {"broad_phase_seconds", c.broad_phase_seconds},
+          {"barrier_seconds", c.barrier_seconds},
+          {"ccd_seconds", c.ccd_seconds}};
+}
+
 nlohmann::json frame_json(const FrameRecord& r) {
   nlohmann::json step_norms = nlohmann::json::array();
   nlohmann::json gradient_norms = nlohmann::json::array();
@@ -27,6 +43,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"step_norm_history", step_norms},
           {"gradient_norm_history", gradient_norms},
           {"friction_iterations", r.friction_iterations},
+          {"contact", contact_json(r)},
           {"seconds", r.newton.wall_seconds},
           {"phase_seconds", phase_times_json(r.newton.times)}};
 }

@@ -6,7 +6,11 @@
 namespace psq::runner {
 
 nlohmann::json phase_times_json(const PhaseTimes& times);
-/// A frame's solve: convergence, energies, per-iteration residuals and time split.
+/// A frame's contact: κ, kinematic pull rounds, active pairs, skips and contact time (all zero
+/// in a scene without contact).
+nlohmann::json contact_json(const FrameRecord& record);
+/// A frame's solve: convergence, energies, per-iteration residuals, time split, friction
+/// iterations and contact_json.
 nlohmann::json frame_json(const FrameRecord& record);
 
 }  // namespace psq::runner

@@ -40,6 +40,26 @@ TEST(SimCommand, WritesEveryFrameAndASummary) {
   }
   // Gravity pulls the sheet down: the elastic energy grows from zero.
   EXPECT_GT(summary["frames"][2]["elastic_energy"].get<double>(), 0.0);
+  // One body without self-contact: no contact work at all.
+  EXPECT_EQ(summary["frames"][2]["contact"]["max_active_pairs"].get<long>(), 0);
+  EXPECT_EQ(summary["frames"][2]["contact"]["barrier_stiffness"].get<double>(), 0.0);
+}
+
+TEST(SimCommand, ContactScenesReportTheirContactAndFrictionPerFrame) {
+  const auto dir = test::fresh_temp_dir("sim_contact");
+  const auto result = test::run_psq({"sim", (test::source_dir() / "jobs/scenes/tilted_plane.toml").string(),
+                                     "--out", (dir / "out").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.errors;
+  std::ifstream in(dir / "out" / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  ASSERT_FALSE(summary["frames"].empty());
+  for (const auto& frame : summary["frames"]) {
+    // The patch rests on the slope in every frame, held there by friction.
+    EXPECT_GT(frame["contact"]["max_active_pairs"].get<long>(), 0);
+    EXPECT_GT(frame["contact"]["barrier_stiffness"].get<double>(), 0.0);
+    EXPECT_GT(frame["contact"]["barrier_evaluations"].get<long>(), 0);
+    EXPECT_GE(frame["friction_iterations"].get<int>(), 2);
+  }
 }
 
 TEST(SimCommand, LevelsRunsProgressivelyAndWritesEveryLevel) {
