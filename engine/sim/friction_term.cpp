@@ -6,6 +6,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/sim/contact_term.hpp"
+#include "engine/solver/solver_stats.hpp"
 
 namespace psq {
 namespace {
@@ -70,6 +71,7 @@ FrictionTerm::FrictionTerm(const ShellSystem& system, double time_step)
 
 void FrictionTerm::lag(ContactPotential& contact, const Eigen::VectorXd& lagged_state,
                        const Eigen::VectorXd& step_start) {
+  const ScopedTimer timer(seconds_);
   const std::vector<int>& vertex_body = contact.surface().vertex_body;
   const BarrierBand& band = contact.parameters().band;
   std::vector<LaggedFrictionContact> lagged;
@@ -84,8 +86,19 @@ void FrictionTerm::lag(ContactPotential& contact, const Eigen::VectorXd& lagged_
   potential_ = FrictionPotential(lagged, step_start, slip_threshold_);
 }
 
+double FrictionTerm::value(const Eigen::VectorXd& x) {
+  const ScopedTimer timer(seconds_);
+  return potential_.value(x);
+}
+
+void FrictionTerm::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+  const ScopedTimer timer(seconds_);
+  potential_.add_gradient(x, g);
+}
+
 void FrictionTerm::hessian(const Eigen::VectorXd& x, Eigen::VectorXd& /*diagonal*/,
                            ElementMatrices& blocks) {
+  const ScopedTimer timer(seconds_);
   potential_.hessian(x, blocks);
 }
 

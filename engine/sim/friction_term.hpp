@@ -55,10 +55,12 @@ class FrictionTerm : public PotentialTerm {
   /// ε = ε_v Δt [m].
   [[nodiscard]] double slip_threshold() const { return slip_threshold_; }
 
-  double value(const Eigen::VectorXd& x) override { return potential_.value(x); }
-  void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
-    potential_.add_gradient(x, g);
-  }
+  /// Time spent lagging and evaluating the term since the last reset [s] (benchmarks).
+  [[nodiscard]] double seconds() const { return seconds_; }
+  void reset_seconds() { seconds_ = 0; }
+
+  double value(const Eigen::VectorXd& x) override;
+  void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
   void hessian(const Eigen::VectorXd& x, Eigen::VectorXd& diagonal,
                ElementMatrices& blocks) override;
 
@@ -66,6 +68,7 @@ class FrictionTerm : public PotentialTerm {
   BodyFrictionTable coefficients_;
   double slip_threshold_;
   FrictionPotential potential_;
+  double seconds_ = 0;
 };
 
 }  // namespace psq

@@ -166,6 +166,7 @@ void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const Newto
   // less than the Newton tolerance (the same velocity-like measure) between outer iterations.
   // Without lagged contacts before and after a solve, re-solving would change nothing.
   potential_.add_term(*friction_);
+  friction_->reset_seconds();
   friction_->lag(contact_->potential(), previous_, previous_);
   Eigen::VectorXd last_solution;
   while (true) {
@@ -182,6 +183,7 @@ void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const Newto
     last_solution = x_;
   }
   potential_.remove_term(*friction_);
+  record.friction_seconds = friction_->seconds();
 }
 
 void QuasistaticSimulation::update_stiffnesses() {

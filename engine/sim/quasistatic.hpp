@@ -45,6 +45,7 @@ struct FrameRecord {
   /// Solves of IPC's outer friction loop (friction scenes only; 0 otherwise): friction lagged at
   /// the frame start, then re-lagged at each solution until the solution settles.
   int friction_iterations = 0;
+  double friction_seconds = 0;  ///< lagging and evaluating friction (within assembly, line search)
 };
 
 /// One quasistatic step without contact, shared by QuasistaticSimulation and the levels of a

@@ -1,6 +1,7 @@
 // Benchmark (prints, never fails on a slow machine): per contact scene of jobs/scenes, the time
 // per Newton iteration split into elastic assembly (with the rest of the objective and line
-// search), contact (broad phase and barrier), CCD, and factorization with the solves; then the
+// search), contact (broad phase and barrier), friction (lagging and evaluation), CCD, and
+// factorization with the solves; then the
 // speed-up from the skips on drape_sphere, whose cloth falls freely for three frames before it
 // meets the ball, simulated with [contact] skip_when_apart on and off.
 //
@@ -57,6 +58,7 @@ struct Totals {
   bool converged = true;
   PhaseTimes newton;
   ContactStats contact;
+  double friction = 0;
   double wall = 0;
 };
 
@@ -71,6 +73,7 @@ Totals run(const Scene& scene) {
     totals.converged = totals.converged && record.newton.converged;
     totals.newton += record.newton.times;
     totals.contact += record.contact;
+    totals.friction += record.friction_seconds;
   }
   totals.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return totals;
@@ -80,12 +83,13 @@ void print_split(const std::string& name, const Totals& t) {
   const double per = 1e3 / std::max(1, t.iterations);
   const double contact = t.contact.broad_phase_seconds + t.contact.barrier_seconds;
   const double ccd = t.contact.ccd_seconds;
-  // Contact and CCD run inside the assembly (gradient, Hessian) and line-search phases.
-  const double elastic = t.newton.assembly + t.newton.line_search - contact - ccd;
+  // Contact, friction and CCD run inside the assembly (gradient, Hessian) and line-search phases.
+  const double elastic = t.newton.assembly + t.newton.line_search - contact - t.friction - ccd;
   const double factorization = t.newton.factorization + t.newton.solve;
-  fmt::print("{:<16} {:>8} {:>6} {:>10.3f} {:>10.3f} {:>10.3f} {:>10.3f} {:>10.3f} {:>9}\n", name,
-             t.vertices, t.iterations, per * elastic, per * contact, per * ccd, per * factorization,
-             per * t.newton.total(), t.converged ? "yes" : "NO");
+  fmt::print(
+      "{:<16} {:>8} {:>6} {:>10.3f} {:>10.3f} {:>10.3f} {:>10.3f} {:>10.3f} {:>10.3f} {:>9}\n",
+      name, t.vertices, t.iterations, per * elastic, per * contact, per * t.friction, per * ccd,
+      per * factorization, per * t.newton.total(), t.converged ? "yes" : "NO");
 }
 
 }  // namespace
@@ -96,8 +100,9 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--scale" && i + 1 < argc) scale = std::stod(argv[++i]);
 
   fmt::print("time per Newton iteration [ms]\n");
-  fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene", "vertices",
-             "iters", "elastic", "contact", "CCD", "factor", "total", "converged");
+  fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
+             "vertices", "iters", "elastic", "contact", "friction", "CCD", "factor", "total",
+             "converged");
   for (const Case& c : kCases) print_split(c.scene, run(load(c, scale, true)));
 
   const Case& drape = kCases.front();
