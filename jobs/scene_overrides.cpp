@@ -22,6 +22,7 @@ struct Slot {
 };
 
 bool positive(double x) { return x > 0; }
+bool non_negative(double x) { return x >= 0; }
 bool at_least_one(double x) { return x >= 1; }
 
 /// The slots of the top-level parameters, by path, in the order parameter_paths lists them.
@@ -39,6 +40,9 @@ const std::vector<std::pair<std::string, Slot>>& scene_slots() {
       {"solver.max_iterations",
        {true, at_least_one, "at least 1",
         [](Scene& s, const nlohmann::json& v) { s.solver.max_iterations = v.get<int>(); }}},
+      {"contact.friction",
+       {false, non_negative, "at least 0",
+        [](Scene& s, const nlohmann::json& v) { s.contact.friction = v.get<double>(); }}},
   };
   return slots;
 }

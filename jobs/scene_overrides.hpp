@@ -3,7 +3,8 @@
 // sweep expansion validates every job with apply_overrides; the executor uses it to build the
 // scene a job runs.
 //
-// Paths: time.step, time.frames, solver.tolerance, solver.max_iterations, and for each shell
+// Paths: time.step, time.frames, solver.tolerance, solver.max_iterations, contact.friction (the
+// scene-wide μ; [[contact.pair]] overrides still apply), and for each shell
 // shell.<name>.material.{youngs_modulus, poisson_ratio, density, thickness}.
 
 #include <string>

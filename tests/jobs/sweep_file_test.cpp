@@ -148,8 +148,9 @@ TEST(SceneOverrides, ApplyingSetsTheScenesValues) {
   const Scene scene = jobs::apply_overrides(
       base, {{kH, 2e-3}, {kNu, 0.4}, {"time.frames", 7}, {"solver.tolerance", 1e-6},
              {"time.step", 0.5}, {"solver.max_iterations", 9}, {kE, 3e9},
-             {"shell.strip.material.density", 10}});
+             {"shell.strip.material.density", 10}, {"contact.friction", 0.4}});
   EXPECT_EQ(scene.shells[0].material.thickness, 2e-3);
+  EXPECT_EQ(scene.contact.friction, 0.4);
   EXPECT_EQ(scene.shells[0].material.poisson_ratio, 0.4);
   EXPECT_EQ(scene.shells[0].material.youngs_modulus, 3e9);
   EXPECT_EQ(scene.shells[0].material.density, 10.0);
@@ -173,6 +174,8 @@ TEST(SceneOverrides, ImpossibleValuesAndUnknownPathsThrowNamingThePath) {
   };
   EXPECT_NE(error(kH, -1e-3).find("must be positive (got -0.001)"), std::string::npos);
   EXPECT_NE(error(kNu, 0.5).find("in (-1, 0.5)"), std::string::npos);
+  EXPECT_NE(error("contact.friction", -0.1).find("must be at least 0 (got -0.1)"),
+            std::string::npos);
   EXPECT_NE(error("time.frames", 2.5).find("an integer"), std::string::npos);
   EXPECT_NE(error("time.frames", 0).find("at least 1"), std::string::npos);
   EXPECT_NE(error(kE, "stiff").find("a number"), std::string::npos);
