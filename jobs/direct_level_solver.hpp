@@ -48,12 +48,13 @@ class DirectLevelSolver final : public LevelSolver {
   const TriMesh& level_rest_mesh() const override { return simulation_.system().rest_mesh(); }
   Positions finest_positions() const override { return as_positions(simulation_.positions()); }
 
+  std::map<std::string, double> state() const override { return simulation_.adaptive_state(); }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
                const Eigen::VectorXd& previous, int iterations_in_frame,
-               const std::map<std::string, double>& /*state*/) override {
+               const std::map<std::string, double>& state) override {
     if (level != 0)
       throw std::invalid_argument(fmt::format("restore: level {} of a direct solve", level));
-    simulation_.restore(frame, positions, previous, iterations_in_frame);
+    simulation_.restore(frame, positions, previous, iterations_in_frame, state);
   }
 
  private:

@@ -112,6 +112,25 @@ bool ContactTerm::update_stiffness(const Eigen::VectorXd& x) {
   return true;
 }
 
+namespace {
+constexpr const char* kStiffnessName = "contact.stiffness";
+constexpr const char* kMaxStiffnessName = "contact.max_stiffness";
+constexpr const char* kPreviousMinDistanceName = "contact.previous_min_distance";
+}  // namespace
+
+void ContactTerm::save_state(std::map<std::string, double>& state) const {
+  state[kStiffnessName] = stiffness_.value;
+  state[kMaxStiffnessName] = stiffness_.max;
+  state[kPreviousMinDistanceName] = previous_min_distance_;
+}
+
+void ContactTerm::load_state(const std::map<std::string, double>& state) {
+  load_named(state, kStiffnessName, stiffness_.value);
+  load_named(state, kMaxStiffnessName, stiffness_.max);
+  load_named(state, kPreviousMinDistanceName, previous_min_distance_);
+  potential_.set_stiffness(stiffness_.value);
+}
+
 void ContactTerm::hessian(const Eigen::VectorXd& x, Eigen::VectorXd& /*diagonal*/,
                           ElementMatrices& blocks) {
   potential_.hessian(x, blocks);

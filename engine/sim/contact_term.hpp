@@ -3,7 +3,9 @@
 // (every shell and collider), the scene's [contact] settings resolved to parameters, and the
 // barrier stiffness κ chosen and adapted as in IPC.
 
+#include <map>
 #include <optional>
+#include <string>
 
 #include "engine/contact/contact_potential.hpp"
 #include "engine/sim/potential_term.hpp"
@@ -46,6 +48,11 @@ class ContactTerm : public PotentialTerm {
   /// when the smallest gap stays below ε_g = 1e-2 d̂ and shrank since the last call. Returns
   /// whether κ changed.
   bool update_stiffness(const Eigen::VectorXd& x);
+
+  /// Adds κ, its upper bound and the last smallest distance to `state` ("contact.*").
+  void save_state(std::map<std::string, double>& state) const;
+  /// Takes back what save_state wrote; names missing from `state` keep their values.
+  void load_state(const std::map<std::string, double>& state);
 
   double value(const Eigen::VectorXd& x) override { return potential_.value(x); }
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {

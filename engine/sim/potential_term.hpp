@@ -4,10 +4,18 @@
 // feasible step, so a new physical effect is one class implementing this interface.
 
 #include <Eigen/Core>
+#include <map>
+#include <string>
 
 #include "engine/core/element_matrices.hpp"
 
 namespace psq {
+
+/// Sets `value` to state[name] when `state` has it (terms restoring their adaptive state).
+inline void load_named(const std::map<std::string, double>& state, const std::string& name,
+                       double& value) {
+  if (const auto found = state.find(name); found != state.end()) value = found->second;
+}
 
 class PotentialTerm {
  public:

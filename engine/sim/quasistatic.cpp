@@ -230,8 +230,16 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   return record;
 }
 
+std::map<std::string, double> QuasistaticSimulation::adaptive_state() const {
+  std::map<std::string, double> state;
+  if (contact_) contact_->save_state(state);
+  if (strain_limit_) strain_limit_->save_state(state);
+  return state;
+}
+
 void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
-                                    const Eigen::VectorXd& previous, int iterations_in_frame) {
+                                    const Eigen::VectorXd& previous, int iterations_in_frame,
+                                    const std::map<std::string, double>& adaptive_state) {
   const bool in_progress = iterations_in_frame > 0;
   if (positions.size() != x_.size() || previous.size() != x_.size())
     throw std::invalid_argument(fmt::format("restore: {} and {} values for {} unknowns",
@@ -245,6 +253,8 @@ void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
   if (strain_limit_)
     strain_limit_->require_feasible(positions,
                                     fmt::format("the restored state of frame {}", frame));
+  if (contact_) contact_->load_state(adaptive_state);
+  if (strain_limit_) strain_limit_->load_state(adaptive_state);
   x_ = positions;
   previous_ = previous;
   frame_ = in_progress ? frame - 1 : frame;

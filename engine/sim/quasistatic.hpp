@@ -14,7 +14,9 @@
 // step, and κ_s adapts between Newton chunks as κ does with contact.
 
 #include <functional>
+#include <map>
 #include <memory>
+#include <string>
 
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/friction_term.hpp"
@@ -89,15 +91,24 @@ class QuasistaticSimulation {
   /// returned with newton.converged = false; numerical failures throw NumericalError.
   FrameRecord step(const Progress& progress = {});
 
+  /// The adaptive stiffnesses reached so far (contact κ and its range, each limited shell's κ_s
+  /// and last slack), by name: with positions, what a stored state needs besides the frame.
+  /// Empty for a scene without contact or strain limits.
+  [[nodiscard]] std::map<std::string, double> adaptive_state() const;
+
   /// Continues from a saved state, exactly as if the run had not stopped. With
   /// `iterations_in_frame` = 0, frame `frame` is solved and `positions` is its result (the next
   /// step() solves frame + 1 from it). Otherwise frame `frame` is in progress: `positions` is its
   /// Newton iterate after `iterations_in_frame` iterations, and the next step() continues that
   /// solve with xᵗ = `previous` and the iterations left of solver.max_iterations.
+  /// `adaptive_state` is adaptive_state() of that moment (names it lacks keep their start
+  /// values). Exact for scenes without contact or strain limits; with them, exact between
+  /// frames, while a frame in progress starts its contact set-up (κ, pulls, friction loop) again.
   /// @throws std::invalid_argument when the sizes or the frame do not fit this simulation;
   /// InputError when `positions` is not strictly below a shell's strain limit.
   void restore(int frame, const Eigen::VectorXd& positions, const Eigen::VectorXd& previous,
-               int iterations_in_frame = 0);
+               int iterations_in_frame = 0,
+               const std::map<std::string, double>& adaptive_state = {});
 
  private:
   /// κ at the frame's start, then the scripted vertices to their targets (directly or pulled).

@@ -63,6 +63,24 @@ void StrainLimitTerm::require_feasible(const Eigen::VectorXd& x, const std::stri
   }
 }
 
+void StrainLimitTerm::save_state(std::map<std::string, double>& state) const {
+  for (std::size_t k = 0; k < energies_.size(); ++k) {
+    const std::string prefix = "strain_limit." + adaptations_[k].shell;
+    state[prefix + ".stiffness"] = energies_[k].stiffness();
+    state[prefix + ".previous_min_slack"] = adaptations_[k].previous_min_slack;
+  }
+}
+
+void StrainLimitTerm::load_state(const std::map<std::string, double>& state) {
+  for (std::size_t k = 0; k < energies_.size(); ++k) {
+    const std::string prefix = "strain_limit." + adaptations_[k].shell;
+    double stiffness = energies_[k].stiffness();
+    load_named(state, prefix + ".stiffness", stiffness);
+    energies_[k].set_stiffness(stiffness);
+    load_named(state, prefix + ".previous_min_slack", adaptations_[k].previous_min_slack);
+  }
+}
+
 void StrainLimitTerm::update_stiffness(const Eigen::VectorXd& x) {
   for (std::size_t k = 0; k < energies_.size(); ++k) {
     Adaptation& adaptation = adaptations_[k];

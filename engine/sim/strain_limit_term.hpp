@@ -5,6 +5,7 @@
 // value or E h δ² and doubles between Newton chunks while the barrier loses against the other
 // forces (update_stiffness).
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,11 @@ class StrainLimitTerm : public PotentialTerm {
   /// Codim-IPC's κ_s update of each limited shell at the iterate x
   /// (update_strain_limit_stiffness, against that shell's slack at the previous call).
   void update_stiffness(const Eigen::VectorXd& x);
+
+  /// Adds each limited shell's κ_s and last slack to `state` ("strain_limit.<shell>.*").
+  void save_state(std::map<std::string, double>& state) const;
+  /// Takes back what save_state wrote; names missing from `state` keep their values.
+  void load_state(const std::map<std::string, double>& state);
 
   /// The limited shells' energies, in scene order of the shells.
   [[nodiscard]] const std::vector<StrainLimitEnergy>& energies() const { return energies_; }
