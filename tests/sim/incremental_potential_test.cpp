@@ -25,6 +25,15 @@ Eigen::MatrixXd assembled_hessian(const HessianBlocks& blocks, const ShellSystem
   return Eigen::MatrixXd(assembler.matrix()).selfadjointView<Eigen::Upper>();
 }
 
+/// Relative error of the potential's gradient at x against central differences (step h) of
+/// its value.
+double gradient_error(IncrementalPotential& potential, const Eigen::VectorXd& x, double h) {
+  Eigen::VectorXd g;
+  potential.gradient(x, g);
+  return test::relative_error(
+      g, test::fd_gradient([&](const Eigen::VectorXd& y) { return potential.value(y); }, x, h));
+}
+
 /// Central differences (step h) of the potential's gradient at x.
 Eigen::MatrixXd fd_hessian(IncrementalPotential& potential, const Eigen::VectorXd& x, double h) {
   return test::fd_jacobian(
@@ -75,11 +84,7 @@ class IncrementalPotentialTest : public ::testing::TestWithParam<BendingModel> {
 };
 
 TEST_P(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
-  Eigen::VectorXd g;
-  potential_.gradient(x_, g);
-  const Eigen::VectorXd fd =
-      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-7);
-  EXPECT_LT(test::relative_error(g, fd), 1e-6);
+  EXPECT_LT(gradient_error(potential_, x_, 1e-7), 1e-6);
 }
 
 TEST_P(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
@@ -171,11 +176,7 @@ TEST_F(ContactPotentialTest, ContactIsASignificantPartOfTheGradient) {
 }
 
 TEST_F(ContactPotentialTest, GradientMatchesFiniteDifferences) {
-  Eigen::VectorXd g;
-  potential_.gradient(x_, g);
-  const Eigen::VectorXd fd =
-      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-9);
-  EXPECT_LT(test::relative_error(g, fd), 1e-5);
+  EXPECT_LT(gradient_error(potential_, x_, 1e-9), 1e-5);
 }
 
 TEST_F(ContactPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
@@ -240,11 +241,7 @@ TEST_F(FrictionObjectiveTest, FrictionIsASignificantPartOfTheGradient) {
 }
 
 TEST_F(FrictionObjectiveTest, GradientMatchesFiniteDifferences) {
-  Eigen::VectorXd g;
-  potential_.gradient(x_, g);
-  const Eigen::VectorXd fd =
-      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-9);
-  EXPECT_LT(test::relative_error(g, fd), 1e-5);
+  EXPECT_LT(gradient_error(potential_, x_, 1e-9), 1e-5);
 }
 
 TEST_F(FrictionObjectiveTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
@@ -304,11 +301,7 @@ TEST_F(StrainLimitPotentialTest,
 }
 
 TEST_F(StrainLimitPotentialTest, GradientMatchesFiniteDifferences) {
-  Eigen::VectorXd g;
-  potential_.gradient(x_, g);
-  const Eigen::VectorXd fd =
-      test::fd_gradient([&](const Eigen::VectorXd& y) { return potential_.value(y); }, x_, 1e-8);
-  EXPECT_LT(test::relative_error(g, fd), 1e-6);
+  EXPECT_LT(gradient_error(potential_, x_, 1e-8), 1e-6);
 }
 
 // The barrier's Hessian is PSD as it stands (docs/friction-and-strain-limiting.md), so the
