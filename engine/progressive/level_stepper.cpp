@@ -41,14 +41,8 @@ FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd&
   record.time = frame * system_.scene().time.step;
   NewtonSettings settings = settings_;
   settings.max_iterations -= iterations_done;
-  const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
-    if (!progress) return;
-    NewtonIteration counted = it;
-    counted.iteration += iterations_done;
-    progress(counted);
-  };
-  record.newton =
-      solve_pinned_step(newton_, *objective_, system_, dofs_, settings, frame, x, numbered);
+  record.newton = solve_pinned_step(newton_, *objective_, system_, dofs_, settings, frame, x,
+                                    offset_progress(progress, iterations_done));
   record.newton.iterations += iterations_done;
   record.elastic_energy = objective_->elastic_energy(x);
   return record;

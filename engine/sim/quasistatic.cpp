@@ -139,12 +139,8 @@ NewtonResult QuasistaticSimulation::solve_in_chunks(const DofMap& dofs,
       contact_ || strain_limit_ ? kStiffnessUpdateInterval : settings.max_iterations;
   NewtonResult total;
   int done = 0;
-  const NewtonSolver::Progress numbered = [&](const NewtonIteration& it) {
-    if (!progress) return;
-    NewtonIteration counted = it;  // numbered within the whole solve, across the chunks
-    counted.iteration += done;
-    progress(counted);
-  };
+  // Numbered within the whole solve, across the chunks.
+  const NewtonSolver::Progress numbered = offset_progress(progress, done);
   NewtonSettings chunk = settings;
   while (true) {
     chunk.max_iterations = std::min(interval, settings.max_iterations - done);
@@ -209,12 +205,11 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   const int frame_number = record.frame;
   NewtonSettings settings = settings_;
   settings.max_iterations -= resumed_iterations;
-  const NewtonSolver::Progress counted_progress = [&](const NewtonIteration& it) {
-    if (!progress) return;
-    NewtonIteration counted = it;  // numbered within the whole frame, across a restore
-    counted.iteration += resumed_iterations;
-    progress(frame_number, counted);
-  };
+  NewtonSolver::Progress frame_progress;
+  if (progress) frame_progress = [&](const NewtonIteration& it) { progress(frame_number, it); };
+  // Numbered within the whole frame, across a restore.
+  const NewtonSolver::Progress counted_progress =
+      offset_progress(frame_progress, resumed_iterations);
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   if (contact_) {
     begin_contact_frame(record, settings, counted_progress);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace psq {
 namespace {
@@ -23,8 +24,8 @@ constexpr double kEnergyRoundoff = 1e-12;
 void check_settings(const NewtonSettings& s) {
   const auto require = [](bool ok, const char* name, double value, const char* range) {
     if (!ok)
-      throw InputError(fmt::format("Newton setting {} = {} is out of range: it must be {}", name,
-                                   value, range));
+      throw InputError(
+          fmt::format("Newton setting {} = {} is out of range: it must be {}", name, value, range));
   };
   require(s.tolerance > 0.0 && std::isfinite(s.tolerance), "tolerance", s.tolerance, "> 0");
   require(s.step_scale > 0.0 && std::isfinite(s.step_scale), "step_scale", s.step_scale, "> 0");
@@ -48,8 +49,8 @@ std::string where(int iteration) {
 void check_gradient(const Eigen::VectorXd& gradient, const DofMap& dofs, int iteration) {
   for (Eigen::Index i = 0; i < gradient.size(); ++i)
     if (dofs.reduced(i) >= 0 && !std::isfinite(gradient[i]))
-      throw NumericalError(fmt::format("gradient is {} at {} {}", gradient[i], dof_name(i),
-                                       where(iteration)));
+      throw NumericalError(
+          fmt::format("gradient is {} at {} {}", gradient[i], dof_name(i), where(iteration)));
 }
 
 /// Mean |K_cc| of an upper-triangular CSC matrix (the diagonal closes each column), or 1 when
@@ -200,6 +201,15 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
       "E = {:.12e})",
       record.iteration, record.gradient_norm, record.feasible_step, record.line_search_trials,
       energy));
+}
+
+NewtonSolver::Progress offset_progress(NewtonSolver::Progress progress, const int& offset) {
+  if (!progress) return {};
+  return [progress = std::move(progress), &offset](const NewtonIteration& it) {
+    NewtonIteration shifted = it;
+    shifted.iteration += offset;
+    progress(shifted);
+  };
 }
 
 }  // namespace psq

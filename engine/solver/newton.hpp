@@ -18,11 +18,11 @@ struct NewtonSettings {
   /// Converged when ‖d‖∞ / step_scale < tolerance for the full Newton step d (IPC's test: a
   /// velocity-like measure when step_scale = Δt).
   double tolerance = 1e-5;
-  double step_scale = 1.0;  ///< Δt of the incremental potential, set by the caller
-  int max_iterations = 100; ///< Newton steps before giving up (result.converged = false)
-  double armijo = 1e-4;     ///< c in E(x + αd) ≤ E(x) + c·α·gᵀd
-  double backtracking = 0.5; ///< α ← backtracking·α after a rejected trial
-  double min_step = 1e-12;  ///< the line search fails once α drops below this (≈ 40 halvings)
+  double step_scale = 1.0;    ///< Δt of the incremental potential, set by the caller
+  int max_iterations = 100;   ///< Newton steps before giving up (result.converged = false)
+  double armijo = 1e-4;       ///< c in E(x + αd) ≤ E(x) + c·α·gᵀd
+  double backtracking = 0.5;  ///< α ← backtracking·α after a rejected trial
+  double min_step = 1e-12;    ///< the line search fails once α drops below this (≈ 40 halvings)
 };
 
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected
@@ -64,5 +64,10 @@ class NewtonSolver {
   CholmodSolver cholmod_;
   Eigen::VectorXd trial_;
 };
+
+/// `progress` with every iteration number shifted by `offset` (read at each call, so it may
+/// grow between calls): a solve that continues earlier iterations numbers its own after them.
+/// Empty when `progress` is.
+NewtonSolver::Progress offset_progress(NewtonSolver::Progress progress, const int& offset);
 
 }  // namespace psq
