@@ -16,6 +16,7 @@
 #include "engine/sim/quasistatic.hpp"
 #include "progressive/nested_cases.hpp"
 #include "progressive/reference_runs.hpp"
+#include "support/library_scene.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -130,7 +131,7 @@ TEST(ProgressiveSimulation, MidedgeDrapeMatchesDirectFineAndPreviewBeatsDirectCo
 
 TEST(ProgressiveSimulation, CylinderMatchesDirectFineAndPreviewBeatsDirectCoarse) {
   // The decimated hierarchy (build_hierarchy) of the library's can at ~400 fine vertices.
-  Scene scene = read_scene(test::source_dir() / "jobs" / "scenes" / "cylinder_compress.toml");
+  Scene scene = test::library_scene("cylinder_compress");
   scene.shells[0].mesh.cylinder.edge_length = 0.01;
   scene.time.step = 0.2;
   scene.time.frames = 5;

@@ -13,6 +13,7 @@
 #include "engine/scene/scene_reader.hpp"
 #include "engine/scene/shell_mesh.hpp"
 #include "engine/scene/vertex_selection.hpp"
+#include "support/library_scene.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -42,10 +43,6 @@ std::vector<BuiltShell> build(const Scene& scene) {
   return out;
 }
 
-Scene example(const std::string& name) {
-  return read_scene(test::source_dir() / "jobs" / "scenes" / (name + ".toml"));
-}
-
 TEST(ExampleScenes, EveryLibrarySceneLoadsAndSelectsVertices) {
   int scenes = 0;
   for (const auto& entry :
@@ -67,7 +64,7 @@ TEST(ExampleScenes, EveryLibrarySceneLoadsAndSelectsVertices) {
 }
 
 TEST(ExampleScenes, DrapeHangsAOneMetreClothByTwoCorners) {
-  const Scene scene = example("drape");
+  const Scene scene = test::library_scene("drape");
   EXPECT_EQ(scene.gravity, Eigen::Vector3d(0, 0, -9.81));
   ASSERT_EQ(scene.shells.size(), 1u);
   const Material& cloth = scene.shells[0].material;
@@ -87,7 +84,7 @@ TEST(ExampleScenes, DrapeHangsAOneMetreClothByTwoCorners) {
 }
 
 TEST(ExampleScenes, HangingSheetIsUprightLimitedAndPinnedAlongItsTopEdge) {
-  const Scene scene = example("hanging_sheet");
+  const Scene scene = test::library_scene("hanging_sheet");
   ASSERT_EQ(scene.shells.size(), 1u);
   ASSERT_TRUE(scene.shells[0].strain_limit);
   EXPECT_EQ(scene.shells[0].strain_limit->limit, 1.05);
@@ -99,7 +96,7 @@ TEST(ExampleScenes, HangingSheetIsUprightLimitedAndPinnedAlongItsTopEdge) {
 }
 
 TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonHalfATurn) {
-  const Scene scene = example("twist");
+  const Scene scene = test::library_scene("twist");
   ASSERT_EQ(scene.shells.size(), 1u);
   const Shell& ribbon = scene.shells[0];
   const BuiltShell shell = build(scene)[0];
@@ -123,7 +120,7 @@ TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonHalfATurn) {
 }
 
 TEST(ExampleScenes, CylinderCompressPinsBothRimsAndPushesTheTopDown) {
-  const Scene scene = example("cylinder_compress");
+  const Scene scene = test::library_scene("cylinder_compress");
   ASSERT_EQ(scene.shells.size(), 1u);
   const Shell& can = scene.shells[0];
   EXPECT_EQ(can.mesh.kind, MeshSource::Kind::Cylinder);
@@ -149,7 +146,7 @@ TEST(ExampleScenes, CylinderCompressPinsBothRimsAndPushesTheTopDown) {
 }
 
 TEST(ExampleScenes, CantileverClampsTwoColumnsAndLoadsTheTipLine) {
-  const Scene scene = example("cantilever");
+  const Scene scene = test::library_scene("cantilever");
   EXPECT_EQ(scene.gravity, Eigen::Vector3d::Zero());
   ASSERT_EQ(scene.shells.size(), 1u);
   const Shell& strip = scene.shells[0];
@@ -173,7 +170,7 @@ std::pair<double, double> z_range(const TriMesh& mesh) {
 }
 
 TEST(ExampleScenes, DrapeSphereHangsTheClothAboveAFixedBallWithFriction) {
-  const Scene scene = example("drape_sphere");
+  const Scene scene = test::library_scene("drape_sphere");
   EXPECT_DOUBLE_EQ(scene.contact.friction, 0.3);
   ASSERT_EQ(scene.colliders.size(), 1u);
   EXPECT_TRUE(scene.colliders[0].motions.empty());
@@ -185,7 +182,7 @@ TEST(ExampleScenes, DrapeSphereHangsTheClothAboveAFixedBallWithFriction) {
 }
 
 TEST(ExampleScenes, TwistWrapTurnsBothEndsInOppositeDirectionsWithSelfContact) {
-  const Scene scene = example("twist_wrap");
+  const Scene scene = test::library_scene("twist_wrap");
   EXPECT_TRUE(scene.contact.self_contact);
   ASSERT_EQ(scene.shells.size(), 1u);
   const Shell& sheet = scene.shells[0];
@@ -206,7 +203,7 @@ TEST(ExampleScenes, TwistWrapTurnsBothEndsInOppositeDirectionsWithSelfContact) {
 }
 
 TEST(ExampleScenes, CylinderCrushIsAThinAluminiumCanUnderADescendingPlate) {
-  const Scene scene = example("cylinder_crush");
+  const Scene scene = test::library_scene("cylinder_crush");
   const Material& can = scene.shells[0].material;
   EXPECT_EQ(can.youngs_modulus, 69e9);
   EXPECT_EQ(can.poisson_ratio, 0.33);
@@ -221,7 +218,7 @@ TEST(ExampleScenes, CylinderCrushIsAThinAluminiumCanUnderADescendingPlate) {
 }
 
 TEST(ExampleScenes, BunnyPressUsesTheVendoredBunnyAboveTheSheet) {
-  const Scene scene = example("bunny_press");
+  const Scene scene = test::library_scene("bunny_press");
   ASSERT_EQ(scene.colliders.size(), 1u);
   EXPECT_EQ(scene.colliders[0].mesh.file, test::source_dir() / "jobs" / "data" / "bunny.obj");
   const TriMesh bunny = build_shell_mesh(scene.colliders[0].mesh);

@@ -6,14 +6,13 @@
 
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
+#include "support/library_scene.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
 
-Scene library_scene(const std::string& name) {
-  return read_scene(test::source_dir() / "jobs" / "scenes" / (name + ".toml"));
-}
+using test::library_scene;
 
 /// Runs `scene` to its end, stopping after frame `cut` to continue in a fresh simulation from
 /// what a checkpoint stores (positions, xᵗ, adaptive state); returns the final positions.

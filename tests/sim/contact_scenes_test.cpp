@@ -5,15 +5,14 @@
 #include <gtest/gtest.h>
 
 #include "engine/scene/scene_reader.hpp"
+#include "support/library_scene.hpp"
 #include "support/scene_run.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
 
-Scene library_scene(const std::string& name) {
-  return read_scene(test::source_dir() / "jobs" / "scenes" / (name + ".toml"));
-}
+using test::library_scene;
 
 /// Sets a generated mesh's target edge length (file meshes are left as they are).
 void set_edge_length(MeshSource& mesh, double edge) {

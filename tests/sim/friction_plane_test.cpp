@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "engine/scene/scene_reader.hpp"
+#include "support/library_scene.hpp"
 #include "support/scene_run.hpp"
 #include "support/test_paths.hpp"
 
@@ -22,7 +23,7 @@ constexpr double kGravity = 9.81;  // m/s², the scene's
 constexpr int kFrames = 5;
 
 Scene tilted_plane() {
-  Scene scene = read_scene(test::source_dir() / "jobs" / "scenes" / "tilted_plane.toml");
+  Scene scene = test::library_scene("tilted_plane");
   scene.time.frames = kFrames;
   return scene;
 }

@@ -14,6 +14,7 @@
 #include "engine/core/error.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
+#include "support/library_scene.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -43,9 +44,7 @@ double largest_principal_stretch(const TriMesh& rest, const Eigen::VectorXd& x) 
   return largest;
 }
 
-Scene hanging_sheet() {
-  return read_scene(test::source_dir() / "jobs" / "scenes" / "hanging_sheet.toml");
-}
+Scene hanging_sheet() { return test::library_scene("hanging_sheet"); }
 
 /// A run of every frame, with σ₁ checked at each stored frame and each accepted Newton iterate.
 struct HangingRun {
