@@ -18,6 +18,16 @@
 namespace psq {
 namespace {
 
+/// Replaces each shell's membrane and bending batches (2s, 2s + 1, the potential's layout) with
+/// their unprojected Hessians at x, so the assembly is the exact Hessian FD can check.
+void unproject_elastics(const ShellSystem& system, const Eigen::VectorXd& x,
+                        HessianBlocks& blocks) {
+  for (std::size_t s = 0; s < system.shells().size(); ++s) {
+    system.membranes()[s].hessian(x, blocks.batches[2 * s], false);
+    system.bendings()[s].hessian(x, blocks.batches[2 * s + 1], false);
+  }
+}
+
 /// The blocks assembled over every DOF of `system` (none fixed), as a dense symmetric matrix.
 Eigen::MatrixXd assembled_hessian(const HessianBlocks& blocks, const ShellSystem& system) {
   SparseAssembler assembler;
@@ -90,8 +100,7 @@ TEST_P(IncrementalPotentialTest, GradientMatchesFiniteDifferences) {
 TEST_P(IncrementalPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);  // the diagonal (inertia) and the batch layout
-  system_.membranes()[0].hessian(x_, blocks.batches[0], false);
-  system_.bendings()[0].hessian(x_, blocks.batches[1], false);
+  unproject_elastics(system_, x_, blocks);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-7)), 1e-5);
 }
@@ -182,10 +191,7 @@ TEST_F(ContactPotentialTest, GradientMatchesFiniteDifferences) {
 TEST_F(ContactPotentialTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);  // the diagonal and the batch layout
-  for (std::size_t s = 0; s < 2; ++s) {
-    system_.membranes()[s].hessian(x_, blocks.batches[2 * s], false);
-    system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
-  }
+  unproject_elastics(system_, x_, blocks);
   contact_.potential().hessian(x_, blocks.batches[4], false);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-9)), 1e-4);
@@ -247,10 +253,7 @@ TEST_F(FrictionObjectiveTest, GradientMatchesFiniteDifferences) {
 TEST_F(FrictionObjectiveTest, UnprojectedAssembledHessianMatchesFiniteDifferences) {
   HessianBlocks blocks;
   potential_.hessian(x_, blocks);  // the diagonal, the friction blocks and the batch layout
-  for (std::size_t s = 0; s < 2; ++s) {
-    system_.membranes()[s].hessian(x_, blocks.batches[2 * s], false);
-    system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
-  }
+  unproject_elastics(system_, x_, blocks);
   contact_.potential().hessian(x_, blocks.batches[4], false);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-9)), 1e-4);
@@ -311,10 +314,7 @@ TEST_F(StrainLimitPotentialTest, AssembledHessianMatchesFiniteDifferences) {
   potential_.hessian(x_, blocks);
   ASSERT_EQ(blocks.batches[4].element_count(),
             static_cast<std::size_t>(system_.rest_mesh().triangle_count()));
-  for (std::size_t s = 0; s < 2; ++s) {
-    system_.membranes()[s].hessian(x_, blocks.batches[2 * s], false);
-    system_.bendings()[s].hessian(x_, blocks.batches[2 * s + 1], false);
-  }
+  unproject_elastics(system_, x_, blocks);
   const Eigen::MatrixXd hessian = assembled_hessian(blocks, system_);
   EXPECT_LT(test::relative_error(hessian, fd_hessian(potential_, x_, 1e-8)), 1e-5);
 }
