@@ -74,12 +74,14 @@ class ProgressiveLevelSolver final : public LevelSolver {
   bool level_done() const override { return simulation_.level_done(); }
   bool finished() const override { return simulation_.finished(); }
   LevelFrame step(const Progress& progress) override {
+    const bool must_converge = simulation_.finest_level();
     const ProgressiveStep step = simulation_.step(
         [&](int, int frame, const NewtonIteration& iteration) { progress(frame, iteration); });
     const NewtonResult& newton = step.frame.newton;
     return {.level = step.level,
             .frame = step.frame.frame,
             .converged = newton.converged,
+            .must_converge = must_converge,
             .iterations = newton.iterations,
             .step_norm = newton.step_norm,
             .gradient_norm = newton.gradient_norm,

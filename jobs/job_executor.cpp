@@ -236,10 +236,7 @@ class JobRun {
           solver_->step([this](int frame, const NewtonIteration& it) { on_iteration(frame, it); });
       resumed_in_frame_.reset();
       frame_energy_ = frame.elastic_energy;
-      // Coarser levels are previews with a fixed Newton budget per frame; only the finest
-      // level's frames must converge.
-      const bool finest = frame.level + 1 == solver_->level_count();
-      if (finest && !frame.converged)
+      if (frame.must_converge && !frame.converged)
         throw NotConverged(fmt::format(
             "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "
             "{:.3e} at the end)",

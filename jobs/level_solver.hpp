@@ -16,8 +16,10 @@ namespace psq::jobs {
 /// One solved frame of a level.
 struct LevelFrame {
   int level = 0;
-  int frame = 0;                ///< 1-based; frame 0 is the rest state
-  bool converged = false;       ///< met the level's tolerance (a preview may stop at its budget)
+  int frame = 0;           ///< 1-based; frame 0 is the rest state
+  bool converged = false;  ///< met the level's tolerance
+  /// Whether the frame had to converge; a preview level's frame may stop at its budget.
+  bool must_converge = true;
   int iterations = 0;           ///< Newton iterations of the frame, including any before a restore
   double step_norm = 0.0;       ///< final ‖d‖∞ / Δt
   double gradient_norm = 0.0;   ///< final ‖∇E‖

@@ -167,7 +167,7 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
   nlohmann::json levels = nlohmann::json::array();
   bool all_converged = true;
   for (;;) {
-    const bool finest = sim.level() + 1 == sim.level_count();
+    const bool finest = sim.finest_level();
     LevelRecord level{sim.level(), sim.level_rest_mesh().vertex_count(),
                       sim.level_rest_mesh().triangle_count()};
     while (!sim.level_done()) {

@@ -170,12 +170,12 @@ const ShellSystem& ProgressiveSimulation::level_system() const { return stepper_
 double ProgressiveSimulation::tolerance() const { return stepper_->settings().tolerance; }
 
 bool ProgressiveSimulation::level_done() const {
-  const int last_frame = level_ + 1 < level_count_ ? refine_frame_ : frame_count();
+  const int last_frame = finest_level() ? frame_count() : refine_frame_;
   return frame_ == last_frame && (!settles() || settled_);
 }
 
 Eigen::VectorXd ProgressiveSimulation::finest_positions() const {
-  return level_ + 1 < level_count_ ? to_finest_[level_].apply(x_) : x_;
+  return finest_level() ? x_ : to_finest_[level_].apply(x_);
 }
 
 ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {

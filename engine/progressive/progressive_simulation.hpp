@@ -81,7 +81,10 @@ class ProgressiveSimulation {
   [[nodiscard]] int frame_count() const { return finest_.scene().time.frames; }
   [[nodiscard]] int refine_frame() const { return refine_frame_; }
   [[nodiscard]] bool level_done() const;
-  [[nodiscard]] bool finished() const { return level_ + 1 == level_count_ && level_done(); }
+  [[nodiscard]] bool finished() const { return finest_level() && level_done(); }
+  /// The current level is the finest: its steps must converge, while coarser levels are
+  /// previews whose steps may stop at preview_iterations.
+  [[nodiscard]] bool finest_level() const { return level_ + 1 == level_count_; }
   /// Whether the current level's settling met its tolerance (rather than max_settle_steps).
   [[nodiscard]] bool level_converged() const { return level_converged_; }
 

@@ -50,8 +50,9 @@ struct FrameRecord {
   double friction_seconds = 0;  ///< lagging and evaluating friction (within assembly, line search)
 };
 
-/// One quasistatic step without contact, shared by QuasistaticSimulation and the levels of a
-/// progressive solve (so that a one-level progressive solve takes exactly the same steps): moves
+/// One quasistatic step without adaptive terms (no contact, no strain limit), as the levels of a
+/// progressive solve take it; QuasistaticSimulation takes the same step for such scenes (its
+/// chunked solve is then one Newton call), so a one-level progressive solve matches it: moves
 /// the pinned vertices of x to their scripted positions at frame·Δt, checks that `objective` is
 /// finite there, and minimizes it with Newton from x over the free DOFs of `dofs`, leaving the
 /// result in x. The caller sets the objective's xᵗ first.

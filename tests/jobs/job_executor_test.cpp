@@ -63,6 +63,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     record.level = level_;
     record.frame = frame;
     record.converged = !(level_ == fail_at_level && frame == fail_at_frame);
+    record.must_converge = level_ + 1 == levels_;  // coarser levels are previews
     record.iterations = iterations_;
     record.elastic_energy = x_.squaredNorm();  // any function of the result will do
     return record;
