@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <sstream>
 
 #include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
@@ -10,19 +9,12 @@
 namespace psq {
 namespace {
 
-std::string read_all(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
   const auto dir = test::fresh_temp_dir("atomic");
   const auto target = dir / "out.txt";
   write_file_atomically(target, [](std::ostream& o) { o << "first"; });
   write_file_atomically(target, [](std::ostream& o) { o << "second"; });
-  EXPECT_EQ(read_all(target), "second");
+  EXPECT_EQ(test::read_file(target), "second");
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 1);
@@ -34,7 +26,7 @@ TEST(AtomicFile, FailedWriterKeepsThePreviousVersion) {
   write_file_atomically(target, [](std::ostream& o) { o << "good"; });
   EXPECT_THROW(write_file_atomically(target, [](std::ostream&) { throw std::runtime_error("boom"); }),
                std::runtime_error);
-  EXPECT_EQ(read_all(target), "good");
+  EXPECT_EQ(test::read_file(target), "good");
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
 }
 

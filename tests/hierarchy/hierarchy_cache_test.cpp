@@ -41,11 +41,6 @@ void expect_identical(const MeshHierarchy& a, const MeshHierarchy& b) {
   }
 }
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size());
 }
@@ -84,7 +79,7 @@ TEST(HierarchyCache, DamagedTruncatedOrForeignFilesAreRebuilt) {
   const auto dir = test::fresh_temp_dir("hierarchy_cache_damage");
   const MeshHierarchy built = load_or_build_hierarchy(cache_mesh(), {}, kSettings, dir);
   const auto file = hierarchy_cache_file(dir, hierarchy_cache_key(cache_mesh(), {}, kSettings));
-  const std::string good = read_bytes(file);
+  const std::string good = test::read_file(file);
 
   std::string flipped = good;
   flipped[flipped.size() / 2] ^= 0x10;
@@ -99,7 +94,7 @@ TEST(HierarchyCache, DamagedTruncatedOrForeignFilesAreRebuilt) {
     const MeshHierarchy again = load_or_build_hierarchy(cache_mesh(), {}, kSettings, dir, &outcome);
     EXPECT_EQ(outcome, HierarchyCacheOutcome::kRebuilt);
     expect_identical(again, built);
-    EXPECT_EQ(read_bytes(file), good);  // the rebuilt file replaced the bad one
+    EXPECT_EQ(test::read_file(file), good);  // the rebuilt file replaced the bad one
   }
 }
 

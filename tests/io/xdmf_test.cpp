@@ -17,7 +17,7 @@ namespace psq {
 namespace {
 
 namespace fs = std::filesystem;
-using test::read_text;
+using test::read_file;
 using test::validate_sidecar;
 using test::SidecarSummary;
 
@@ -50,7 +50,7 @@ TEST(Xdmf, SidecarMatchesItsHdf5Files) {
   EXPECT_EQ(summary.uniform_grids, 3);
   EXPECT_EQ(summary.hdf_items, 3 * 3);  // triangles, positions, rest positions per grid
   EXPECT_EQ(summary.times, (std::vector<std::string>{"0", "1", "2"}));
-  const std::string xml = read_text(job.dir / "job.xdmf");
+  const std::string xml = read_file(job.dir / "job.xdmf");
   EXPECT_NE(xml.find(R"(<Xdmf Version="3.0">)"), std::string::npos);
   EXPECT_NE(xml.find(R"(CollectionType="Temporal")"), std::string::npos);
   EXPECT_NE(xml.find(R"(Name="level1_frame2")"), std::string::npos);

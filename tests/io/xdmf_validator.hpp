@@ -13,15 +13,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/test_paths.hpp"
 
 namespace psq::test {
-
-inline std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 inline std::string trimmed(const std::string& text) {
   const auto first = text.find_first_not_of(" \t\n");
@@ -115,7 +109,7 @@ struct SidecarSummary {
 /// Validates a sidecar: nesting, every DataItem (HDF ones against their files, inline ones by
 /// their number of values), and each Topology's element count against its DataItem.
 inline SidecarSummary validate_sidecar(const std::filesystem::path& sidecar) {
-  const std::string xml = read_text(sidecar);
+  const std::string xml = test::read_file(sidecar);
   SidecarSummary summary;
   summary.problems = nesting_problems(xml);
   static const std::regex item(R"re(<DataItem([^>]*)>([^<]*)</DataItem>)re");

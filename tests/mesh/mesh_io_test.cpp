@@ -44,13 +44,6 @@ void expect_rejected(const std::string& name, const std::string& text, long line
   expect_input_error([&] { read_mesh(path); }, parts);
 }
 
-std::string read_all(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // A closed mesh with irrational coordinates, so that round trips must be exact to pass.
 TriMesh coarse_sphere() { return make_sphere({.radius = 0.7, .edge_length = 0.45}); }
 
@@ -120,7 +113,7 @@ TEST(MeshIo, RoundTripIsExactForEveryFormat) {
 TEST(MeshIo, PlyIsWrittenBinaryLittleEndian) {
   const auto path = test::fresh_temp_dir("mesh-io") / "square.ply";
   write_mesh(path, unit_square());
-  const std::string bytes = read_all(path);
+  const std::string bytes = test::read_file(path);
   EXPECT_NE(bytes.find("format binary_little_endian 1.0\n"), std::string::npos);
   // Header, then 4 vertices × 3 doubles and 2 faces × (1 count byte + 3 ints).
   const std::size_t data = bytes.find("end_header\n") + std::string("end_header\n").size();

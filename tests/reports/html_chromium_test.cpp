@@ -91,7 +91,7 @@ TEST(HtmlReportInChromium, ShowsEveryPlotAndPictureAndScreenshotsAsARealPage) {
 
   const auto probe = test::write_file(
       dir / "report" / "probe.html",
-      probe_page(test::read_report_file(outcome.page), test::read_report_file(screenshot)));
+      probe_page(test::read_file(outcome.page), test::read_file(screenshot)));
   const auto dump = chromium(
       dir / "profile", {"--dump-dom", "--virtual-time-budget=10000", "file://" + probe.string()});
   ASSERT_EQ(dump.exit_code, 0) << dump.errors;

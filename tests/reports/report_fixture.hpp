@@ -12,13 +12,13 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "support/test_paths.hpp"
 
 namespace psq::test {
 
@@ -58,14 +58,6 @@ struct FixtureJob {
             {"scene", "fnv1a64:00000000000000aa"}};
   }
 };
-
-/// The bytes of a file (a report's output) read back whole.
-inline std::string read_report_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
 
 /// Newton-like history: per frame, the residual drops quadratically from `start`.
 inline std::vector<double> newton_history(int frames, double start) {

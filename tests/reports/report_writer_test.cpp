@@ -89,7 +89,7 @@ TEST_F(ReportWriter, WritesTheFourFilesAndNothingElse) {
 }
 
 TEST_F(ReportWriter, CsvHasOneRowPerJobWithTheInputsAndDerivedValues) {
-  const auto records = parse_csv(test::read_report_file(dir_ / "report" / "results.csv"));
+  const auto records = parse_csv(test::read_file(dir_ / "report" / "results.csv"));
   const auto jobs = test::fixture_jobs();
   ASSERT_EQ(records.size(), jobs.size() + 1);
   const std::vector<std::string>& header = records[0];
@@ -151,7 +151,7 @@ TEST_F(ReportWriter, CsvHasOneRowPerJobWithTheInputsAndDerivedValues) {
 }
 
 TEST_F(ReportWriter, JsonHoldsEveryJobWithItsLevelsAndResidualHistories) {
-  const auto json = nlohmann::json::parse(test::read_report_file(dir_ / "report" / "results.json"));
+  const auto json = nlohmann::json::parse(test::read_file(dir_ / "report" / "results.json"));
   const auto jobs = test::fixture_jobs();
   EXPECT_EQ(json["sweep"], "plates");
   EXPECT_EQ(json["source"], "sweeps/plates.toml");
@@ -192,7 +192,7 @@ TEST_F(ReportWriter, JsonHoldsEveryJobWithItsLevelsAndResidualHistories) {
 }
 
 TEST_F(ReportWriter, MarkdownSummaryHasTheTablesAndTheProblems) {
-  const std::string markdown = test::read_report_file(dir_ / "report" / "summary.md");
+  const std::string markdown = test::read_file(dir_ / "report" / "summary.md");
   EXPECT_NE(markdown.find("# Sweep plates"), std::string::npos);
   EXPECT_NE(markdown.find("| done | 4 |"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("| 4 | 00000000 | 2 | 0.002 | 1e+07 | failed |"), std::string::npos)
@@ -205,7 +205,7 @@ TEST_F(ReportWriter, MarkdownSummaryHasTheTablesAndTheProblems) {
 }
 
 TEST_F(ReportWriter, HtmlHasEveryPlotAndPictureAndNoNetworkReference) {
-  const std::string html = test::read_report_file(dir_ / "report" / "report.html");
+  const std::string html = test::read_file(dir_ / "report" / "report.html");
   // Plots: time per level, error against run time, 3 swept parameters × 3 outputs, and the
   // residual plots of the 4 finished jobs. Pictures: the levels with a readable checkpoint of
   // finished jobs: 3 (job 1) + 1 (job 2, level 0) + 1 (job 3).
@@ -228,8 +228,8 @@ TEST_F(ReportWriter, ReplacesAnEarlierReportWhole) {
   write_report({database_, "plates", out, "gnuplot"});
   EXPECT_FALSE(std::filesystem::exists(out / "stray.txt"));
   EXPECT_TRUE(std::filesystem::exists(out / "summary.md"));
-  EXPECT_EQ(test::read_report_file(out / "results.csv"),
-            test::read_report_file(dir_ / "report" / "results.csv"));
+  EXPECT_EQ(test::read_file(out / "results.csv"),
+            test::read_file(dir_ / "report" / "results.csv"));
 }
 
 TEST_F(ReportWriter, AFailureLeavesNoHalfReportAndKeepsTheEarlierOne) {
@@ -238,9 +238,9 @@ TEST_F(ReportWriter, AFailureLeavesNoHalfReportAndKeepsTheEarlierOne) {
   EXPECT_FALSE(std::filesystem::exists(fresh));
   const auto earlier = dir_ / "earlier";
   write_report({database_, "plates", earlier, "gnuplot"});
-  const std::string before = test::read_report_file(earlier / "report.html");
+  const std::string before = test::read_file(earlier / "report.html");
   EXPECT_THROW(write_report({database_, "plates", earlier, "/nonexistent/gnuplot"}), InputError);
-  EXPECT_EQ(test::read_report_file(earlier / "report.html"), before);
+  EXPECT_EQ(test::read_file(earlier / "report.html"), before);
   for (const auto& entry : std::filesystem::directory_iterator(dir_))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
 }
@@ -255,7 +255,7 @@ TEST_F(ReportWriter, RefusesToReplaceADirectoryItDidNotWrite) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("refusing to replace"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(test::read_report_file(mine / "notes.txt"), "precious");
+  EXPECT_EQ(test::read_file(mine / "notes.txt"), "precious");
   EXPECT_FALSE(std::filesystem::exists(mine / "report.html"));
 }
 
@@ -282,12 +282,12 @@ TEST_F(ReportWriter, EverySweepGoesToItsOwnDirectoryWithAnIndex) {
   EXPECT_EQ(outcome.page, out / "index.html");
   EXPECT_TRUE(std::filesystem::exists(out / "plates" / "report.html"));
   EXPECT_TRUE(std::filesystem::exists(out / "plates_again_2" / "results.csv"));
-  const std::string index = test::read_report_file(out / "index.html");
+  const std::string index = test::read_file(out / "index.html");
   EXPECT_NE(index.find("<a href=\"plates_again_2/report.html\">plates again/2</a>"),
             std::string::npos)
       << index;
   const auto shared =
-      nlohmann::json::parse(test::read_report_file(out / "plates_again_2" / "results.json"));
+      nlohmann::json::parse(test::read_file(out / "plates_again_2" / "results.json"));
   ASSERT_EQ(shared["jobs"].size(), 1u);
   EXPECT_EQ(shared["jobs"][0]["state"], "done");  // the job is shared, with its results
 }

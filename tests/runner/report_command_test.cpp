@@ -45,7 +45,7 @@ TEST_F(ReportCommand, WritesTheReportOfASweepAndPrintsItsPage) {
       << result.output;
   EXPECT_NE(result.output.find("2 problems"), std::string::npos) << result.output;
 
-  const auto json = nlohmann::json::parse(test::read_report_file(out / "results.json"));
+  const auto json = nlohmann::json::parse(test::read_file(out / "results.json"));
   const auto jobs = test::fixture_jobs();
   ASSERT_EQ(json["jobs"].size(), jobs.size());
   for (std::size_t j = 0; j < jobs.size(); ++j) {
@@ -57,13 +57,13 @@ TEST_F(ReportCommand, WritesTheReportOfASweepAndPrintsItsPage) {
   EXPECT_EQ(json["jobs"][0]["levels"][0]["iterations"], jobs[0].levels[0].residuals.size());
   EXPECT_EQ(json["jobs"][0]["outputs"]["elastic_energy"], 0.125);
 
-  const std::string csv = test::read_report_file(out / "results.csv");
+  const std::string csv = test::read_file(out / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);  // header + 6 jobs
   EXPECT_NE(csv.find("\r\n3,00000000000000c3,1,0.001,1e+07,fnv1a64:00000000000000aa,done,"),
             std::string::npos)
       << csv;
   EXPECT_TRUE(std::filesystem::exists(out / "summary.md"));
-  EXPECT_NE(test::read_report_file(out / "report.html").find("<h1>Sweep plates</h1>"),
+  EXPECT_NE(test::read_file(out / "report.html").find("<h1>Sweep plates</h1>"),
             std::string::npos);
 }
 
@@ -108,7 +108,7 @@ TEST_F(ReportCommand, AnUnwritableOutExitsOneAndLeavesNothingHalfWritten) {
   EXPECT_EQ(onto_file.exit_code, 1);
   EXPECT_NE(onto_file.errors.find("it exists and is not a directory"), std::string::npos)
       << onto_file.errors;
-  EXPECT_EQ(test::read_report_file(blocker), "a file");
+  EXPECT_EQ(test::read_file(blocker), "a file");
   // The proc file system refuses new directories outright.
   const auto in_proc = psq({"report", "plates", "--out", "/proc/psq-report-test"});
   EXPECT_EQ(in_proc.exit_code, 1);

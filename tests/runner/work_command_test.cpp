@@ -168,7 +168,7 @@ TEST_F(WorkCommand, BadSweepsAreRefusedAndAddNothing) {
 
 TEST_F(WorkCommand, AJobWhoseSceneChangedFailsForGoodWithAClearMessage) {
   ASSERT_EQ(add_sweep("\"time.frames\" = [3]\n"), 0);
-  test::write_file(dir_ / "scene.toml", "# edited\n" + test::read_text(dir_ / "scene.toml"));
+  test::write_file(dir_ / "scene.toml", "# edited\n" + test::read_file(dir_ / "scene.toml"));
   const auto work = psq({"work", "--workers", "1"});
   EXPECT_EQ(work.exit_code, 5);
   const db::JobResult r = results().front();
@@ -193,7 +193,7 @@ TEST_F(WorkCommand, AnUnwritableOutputDirectoryStopsTheWorkerAndKeepsTheJobQueue
 TEST_F(WorkCommand, AFullDiskStopsTheWorkerCleanlyAndTheWorkResumesLater) {
   // A finer strip (729 vertices): its checkpoints (~100 kB) exceed the limit, while the store's
   // files (the -shm index takes 32 kB) stay below it.
-  std::string scene = test::read_text(dir_ / "scene.toml");
+  std::string scene = test::read_file(dir_ / "scene.toml");
   scene.replace(scene.find("edge_length = 0.005"), 19, "edge_length = 0.0025");
   test::write_file(dir_ / "scene.toml", scene);
   ASSERT_EQ(add_sweep("\"shell.strip.material.thickness\" = [8e-4, 1e-3]\n"), 0);

@@ -1,7 +1,6 @@
 #include "support/run_process.hpp"
 
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,13 +9,6 @@
 
 namespace psq::test {
 namespace {
-
-std::string read_all(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 }  // namespace
 
@@ -40,8 +32,8 @@ ProcessResult run_process(const std::string& program, const std::vector<std::str
   ::waitpid(pid, &status, 0);
   ProcessResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.output = read_all(out_path);
-  result.errors = read_all(err_path);
+  result.output = read_file(out_path);
+  result.errors = read_file(err_path);
   return result;
 }
 

@@ -1,8 +1,10 @@
 #include "support/test_paths.hpp"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <fstream>
-#include <unistd.h>
+#include <iterator>
 
 namespace psq::test {
 
@@ -22,6 +24,11 @@ std::filesystem::path write_file(const std::filesystem::path& path, const std::s
   std::ofstream out(path, std::ios::binary);
   out << text;
   return path;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace psq::test
