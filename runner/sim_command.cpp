@@ -1,4 +1,4 @@
-// `psq sim SCENE --out DIR [--levels L]`: a simulation of a scene, direct at its full
+// `psq sim SCENE --out DIR [--levels L] [--cache DIR]`: a simulation of a scene, direct at its full
 // resolution (levels = 1) or progressive over a hierarchy of L levels (docs/progressive.md).
 
 #include <fmt/format.h>
@@ -27,6 +27,7 @@ struct SimOptions {
   std::string scene;
   std::string out;
   std::optional<int> levels;
+  std::string cache;  ///< hierarchy cache directory; empty: build without a cache
 };
 
 void write_positions(const std::filesystem::path& path, const TriMesh& rest,
@@ -116,6 +117,7 @@ ProgressiveSettings settings_for(const Scene& scene, const SimOptions& options) 
       throw InputError(fmt::format("--levels must be at least 1 (got {})", *options.levels));
     settings.schedule.levels = *options.levels;
   }
+  settings.cache_dir = options.cache;
   return settings;
 }
 
@@ -204,6 +206,8 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
   nlohmann::json summary =
       run_summary(scene, rest, sim.finest_tolerance(), sim.level_count(), all_converged, frames);
   summary["refine_frame"] = sim.refine_frame();
+  if (!settings.cache_dir.empty())
+    summary["hierarchy_cache"] = std::filesystem::absolute(settings.cache_dir).string();
   summary["levels"] = levels;
   return finish(out, summary, all_converged);
 }
@@ -229,6 +233,9 @@ void register_sim_command(CLI::App& app, std::vector<Command>& commands) {
       ->required();
   command->add_option("--levels", options->levels,
                       "Hierarchy levels (overrides [hierarchy] levels; 1 = direct)");
+  command->add_option("--cache", options->cache,
+                      "Directory of built hierarchies, reused by later runs of the same mesh, "
+                      "depth and decimation settings (created if missing; default: no cache)");
   commands.push_back({command, [options] { return run_sim(*options); }});
 }
 

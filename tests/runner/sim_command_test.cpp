@@ -1,10 +1,10 @@
 // `psq sim` end to end, as a user runs it: outputs, exit codes and messages.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sys/stat.h>
 
 #include "support/run_process.hpp"
 #include "support/test_paths.hpp"
@@ -14,11 +14,14 @@ namespace {
 
 /// A small, fast scene: a 0.2 m sheet pinned along one edge, sagging under gravity.
 std::string small_scene(int frames) {
-  return "name = \"sag\"\ngravity = [0, 0, -9.81]\n[time]\nstep = 0.05\nframes = " + std::to_string(frames) +
+  return "name = \"sag\"\ngravity = [0, 0, -9.81]\n[time]\nstep = 0.05\nframes = " +
+         std::to_string(frames) +
          "\n[[shell]]\nname = \"sheet\"\n"
          "mesh = { generator = \"sheet\", width = 0.2, height = 0.2, edge_length = 0.04 }\n"
-         "material = { youngs_modulus = 1e5, poisson_ratio = 0.3, density = 200, thickness = 1e-3 }\n"
-         "[[shell.pin]]\nname = \"edge\"\nbox = { min = [-0.11, -0.11, -0.01], max = [-0.09, 0.11, 0.01] }\n";
+         "material = { youngs_modulus = 1e5, poisson_ratio = 0.3, density = 200, thickness = 1e-3 "
+         "}\n"
+         "[[shell.pin]]\nname = \"edge\"\nbox = { min = [-0.11, -0.11, -0.01], max = [-0.09, 0.11, "
+         "0.01] }\n";
 }
 
 TEST(SimCommand, WritesEveryFrameAndASummary) {
@@ -27,7 +30,8 @@ TEST(SimCommand, WritesEveryFrameAndASummary) {
   const auto result = test::run_psq({"sim", scene.string(), "--out", (dir / "out").string()});
   ASSERT_EQ(result.exit_code, 0) << result.errors;
   for (int f = 0; f <= 3; ++f)
-    EXPECT_TRUE(std::filesystem::exists(dir / "out" / ("frame_000" + std::to_string(f) + ".obj"))) << f;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / ("frame_000" + std::to_string(f) + ".obj")))
+        << f;
   EXPECT_NE(result.output.find("summary.json"), std::string::npos);
   std::ifstream in(dir / "out" / "summary.json");
   const auto summary = nlohmann::json::parse(in);
@@ -47,8 +51,9 @@ TEST(SimCommand, WritesEveryFrameAndASummary) {
 
 TEST(SimCommand, ContactScenesReportTheirContactAndFrictionPerFrame) {
   const auto dir = test::fresh_temp_dir("sim_contact");
-  const auto result = test::run_psq({"sim", (test::source_dir() / "jobs/scenes/tilted_plane.toml").string(),
-                                     "--out", (dir / "out").string()});
+  const auto result =
+      test::run_psq({"sim", (test::source_dir() / "jobs/scenes/tilted_plane.toml").string(),
+                     "--out", (dir / "out").string()});
   ASSERT_EQ(result.exit_code, 0) << result.errors;
   std::ifstream in(dir / "out" / "summary.json");
   const auto summary = nlohmann::json::parse(in);
@@ -98,6 +103,40 @@ TEST(SimCommand, LevelsRunsProgressivelyAndWritesEveryLevel) {
   EXPECT_EQ(summary["frames"].size(), fine["steps"].size());
 }
 
+TEST(SimCommand, CacheKeepsTheHierarchyForTheNextRunWhichEndsTheSame) {
+  const auto dir = test::fresh_temp_dir("sim_cache");
+  std::string text = small_scene(2);
+  text.replace(text.find("edge_length = 0.04"), 18, "edge_length = 0.02");
+  const auto scene = test::write_file(dir / "sag.toml", text);
+  const auto cache = dir / "cache";
+  const auto run = [&](const std::string& out) {
+    return test::run_psq({"sim", scene.string(), "--out", (dir / out).string(), "--levels", "2",
+                          "--cache", cache.string()});
+  };
+  const auto first = run("first");
+  ASSERT_EQ(first.exit_code, 0) << first.errors;
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(cache))
+    files.push_back(entry.path());
+  ASSERT_EQ(files.size(), 1u);  // one shell, one hierarchy
+  const auto written = std::filesystem::last_write_time(files[0]);
+  const std::string stored = test::read_file(files[0]);
+
+  const auto second = run("second");
+  ASSERT_EQ(second.exit_code, 0) << second.errors;
+  // Read, not rebuilt: the file is untouched, and the run is the first one again.
+  EXPECT_EQ(std::filesystem::last_write_time(files[0]), written);
+  EXPECT_EQ(test::read_file(files[0]), stored);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(cache),
+                          std::filesystem::directory_iterator{}),
+            1);
+  EXPECT_EQ(test::read_file(dir / "second" / "frame_0002.obj"),
+            test::read_file(dir / "first" / "frame_0002.obj"));
+  std::ifstream in(dir / "second" / "summary.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["hierarchy_cache"].get<std::string>(),
+            std::filesystem::absolute(cache).string());
+}
+
 TEST(SimCommand, LevelsBelowOneIsAnInputError) {
   const auto dir = test::fresh_temp_dir("sim_levels");
   const auto scene = test::write_file(dir / "sag.toml", small_scene(1));
@@ -125,7 +164,8 @@ TEST(SimCommand, UnwritableOutputDirectoryIsAnInputError) {
     const auto dir = test::fresh_temp_dir("sim");
     const auto scene = test::write_file(dir / "sag.toml", small_scene(1));
     test::write_file(dir / "file", "x");
-    const auto result = test::run_psq({"sim", scene.string(), "--out", (dir / "file" / "out").string()});
+    const auto result =
+        test::run_psq({"sim", scene.string(), "--out", (dir / "file" / "out").string()});
     EXPECT_EQ(result.exit_code, 1);
     EXPECT_NE(result.errors.find("output directory"), std::string::npos) << result.errors;
     return;
@@ -148,7 +188,8 @@ TEST(SimCommand, MissingSceneAndMissingArgumentsFail) {
 
 TEST(SimCommand, TooFewIterationsIsReportedWithExitCodeThree) {
   const auto dir = test::fresh_temp_dir("sim");
-  const auto scene = test::write_file(dir / "sag.toml", small_scene(1) + "[solver]\nmax_iterations = 1\n");
+  const auto scene =
+      test::write_file(dir / "sag.toml", small_scene(1) + "[solver]\nmax_iterations = 1\n");
   const auto result = test::run_psq({"sim", scene.string(), "--out", (dir / "out").string()});
   EXPECT_EQ(result.exit_code, 3) << result.errors;
   std::ifstream in(dir / "out" / "summary.json");
