@@ -7,13 +7,14 @@
 // than the direct fine solve; progressive total faster than the direct fine solve.
 //
 // Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
-//                          [--scenes drape,twist,cylinder_compress]
+//                          [--preview-tolerance T] [--scenes drape,twist,cylinder_compress]
 
 #include <fmt/format.h>
 
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "engine/progressive/progressive_simulation.hpp"
@@ -65,15 +66,21 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
   while (true) {
     start = Clock::now();
     int steps = 0, iterations = 0;
+    psq::PhaseTimes phases;
     while (!sim.level_done()) {
-      iterations += sim.step().frame.newton.iterations;
+      const psq::ProgressiveStep step = sim.step();
+      iterations += step.frame.newton.iterations;
+      phases += step.frame.newton.times;
       ++steps;
     }
     const double level_seconds = seconds_since(start);
     total_seconds += level_seconds;
-    std::cout << fmt::format("  level {} ({} vertices): {} steps, {} iterations, {:.2f} s{}\n",
-                             sim.level(), sim.level_rest_mesh().vertex_count(), steps, iterations,
-                             level_seconds, sim.level_converged() ? "" : " (NOT converged)");
+    std::cout << fmt::format(
+        "  level {} ({} vertices): {} steps, {} iterations, {:.2f} s{} [assembly {:.2f}, "
+        "factorization {:.2f}, solve {:.2f}, line search {:.2f} s]\n",
+        sim.level(), sim.level_rest_mesh().vertex_count(), steps, iterations, level_seconds,
+        sim.level_converged() ? "" : " (NOT converged)", phases.assembly, phases.factorization,
+        phases.solve, phases.line_search);
     if (sim.level() == 0) {
       preview = sim.finest_positions();
       preview_seconds = level_seconds;
@@ -119,6 +126,7 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
 int main(int argc, char** argv) {
   int vertices = 20000, levels = 3, frames = 10;
   std::string gradient = "exact";  // the solver's default (ProgressiveSettings)
+  std::optional<double> preview_tolerance;  // unset: the scene's (default 10 × its tolerance)
   std::vector<std::string> scenes{"drape", "twist", "cylinder_compress"};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
@@ -126,6 +134,7 @@ int main(int argc, char** argv) {
     else if (arg == "--levels") levels = std::stoi(value);
     else if (arg == "--frames") frames = std::stoi(value);
     else if (arg == "--gradient") gradient = value;
+    else if (arg == "--preview-tolerance") preview_tolerance = std::stod(value);
     else if (arg == "--scenes") scenes = split(value);
     else {
       std::cerr << "unknown option " << arg << "\n";
@@ -138,6 +147,7 @@ int main(int argc, char** argv) {
     const psq::Scene scene = sized_scene(name, vertices, frames);
     psq::ProgressiveSettings settings = psq::ProgressiveSettings::from_scene(scene);
     settings.schedule.levels = levels;
+    if (preview_tolerance) settings.schedule.preview_tolerance = preview_tolerance;
     settings.gradient =
         gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
     run_scene(scene, settings);
