@@ -95,7 +95,7 @@ TEST(ExampleScenes, HangingSheetIsUprightLimitedAndPinnedAlongItsTopEdge) {
   for (int v : top) EXPECT_NEAR(shell.mesh.vertices(v, 2), 0.1, 1e-12);
 }
 
-TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonHalfATurn) {
+TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonAThirdOfATurn) {
   const Scene scene = test::library_scene("twist");
   ASSERT_EQ(scene.shells.size(), 1u);
   const Shell& ribbon = scene.shells[0];
@@ -111,11 +111,15 @@ TEST(ExampleScenes, TwistTurnsOneEndOfTheRibbonHalfATurn) {
   EXPECT_TRUE(ribbon.pins[0].motions.empty());
   const auto& motions = ribbon.pins[1].motions;
   const double end = scene.time.step * scene.time.frames;
-  // Half a turn about the x axis maps (x, y, z) to (x, -y, -z), reached by the last frame.
+  // 120° about the x axis maps (0.2, 0.05, 0) to (0.2, 0.05 cos 120°, 0.05 sin 120°), reached by
+  // the last frame.
   const Eigen::Vector3d corner(0.2, 0.05, 0);
-  EXPECT_LT((apply_motions(motions, corner, end) - Eigen::Vector3d(0.2, -0.05, 0)).norm(), 1e-12);
-  // A quarter of the way through, a quarter of the half turn (45°).
-  const Eigen::Vector3d quarter(0.2, 0.05 * std::sqrt(0.5), 0.05 * std::sqrt(0.5));
+  EXPECT_LT((apply_motions(motions, corner, end) -
+             Eigen::Vector3d(0.2, -0.025, 0.05 * std::sqrt(0.75)))
+                .norm(),
+            1e-12);
+  // A quarter of the way through, a quarter of the turn (30°).
+  const Eigen::Vector3d quarter(0.2, 0.05 * std::sqrt(0.75), 0.025);
   EXPECT_LT((apply_motions(motions, corner, 0.25 * end) - quarter).norm(), 1e-12);
 }
 
