@@ -7,6 +7,8 @@
 #include <new>
 #include <stdexcept>
 
+#include "engine/solver/blas_threads.hpp"
+
 namespace psq {
 namespace {
 
@@ -56,6 +58,7 @@ struct CholmodSolver::State {
   bool factorized = false;
 
   State() {
+    use_single_threaded_blas();
     cholmod_start(&common);
     common.supernodal = CHOLMOD_SUPERNODAL;
     common.print = 0;  // the engine never prints; failures become exceptions

@@ -1,0 +1,18 @@
+#pragma once
+// How many threads the BLAS under CHOLMOD's supernodal factorization may use.
+//
+// OpenBLAS (the BLAS that scripts/setup.sh installs) starts one busy-waiting thread per core.
+// On the 2-core machines PSQ runs on, every factorization then competes with whatever else
+// runs — the test suite's second job, a second sweep worker, a build — and spinning threads
+// lose more than they gain. Measured with bench_drape under such load (factorization ms per
+// Newton iteration, 2 threads → 1): 1.1k vertices 52–59 → 16–25, 5.3k 191–312 → 140–142,
+// 21k 1423–1627 → 1110–1354. So PSQ factorizes single-threaded unless the user says otherwise.
+
+namespace psq {
+
+/// Sets OpenBLAS to one thread, once per process, unless OPENBLAS_NUM_THREADS,
+/// GOTO_NUM_THREADS or OMP_NUM_THREADS is set (the user's choice wins). Another BLAS is left
+/// as it is. Returns whether the thread count was set.
+bool use_single_threaded_blas();
+
+}  // namespace psq
