@@ -19,6 +19,7 @@ constexpr double kPreviewToleranceFactor = 10.0;
 // Names of the schedule_state() scalars.
 constexpr const char* kFramesDone = "progressive.frames_done";
 constexpr const char* kSettleSteps = "progressive.settle_steps";
+constexpr const char* kSettleGrowth = "progressive.settle_growth";
 constexpr const char* kSettled = "progressive.settled";
 constexpr const char* kLevelConverged = "progressive.level_converged";
 
@@ -163,6 +164,7 @@ void ProgressiveSimulation::enter_level(int level) {
   settled_ = false;
   level_converged_ = false;
   settle_steps_ = 0;
+  settle_growth_ = 0;
 }
 
 const ShellSystem& ProgressiveSimulation::level_system() const { return stepper_->system(); }
@@ -186,7 +188,7 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   out.settling = settles() && frame_ == refine_frame_ && !settled_;
   const int frame = out.settling ? frame_ : frame_ + 1;
   const double time_step = out.settling
-                               ? settling_time_step(finest_.scene().time.step, settle_steps_)
+                               ? settling_time_step(finest_.scene().time.step, settle_growth_)
                                : finest_.scene().time.step;
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   const int iterations_done = std::exchange(resumed_iterations_, 0);
@@ -198,8 +200,11 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
   if (out.settling) {
-    level_converged_ = settling_done(settle_steps_, out.change, tolerance());
+    level_converged_ = settling_done(settle_growth_, out.change, tolerance());
     ++settle_steps_;
+    const bool nothing_to_solve = out.frame.newton.converged && out.frame.newton.iterations == 0;
+    settle_growth_ =
+        nothing_to_solve ? std::max(settle_growth_ + 1, kSettlingGrowthSteps) : settle_growth_ + 1;
     settled_ = level_converged_ || settle_steps_ >= settings_.max_settle_steps;
   }
   return out;
@@ -221,6 +226,7 @@ void ProgressiveSimulation::refine() {
 std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
   return {{kFramesDone, frame_},
           {kSettleSteps, settle_steps_},
+          {kSettleGrowth, settle_growth_},
           {kSettled, settled_ ? 1.0 : 0.0},
           {kLevelConverged, level_converged_ ? 1.0 : 0.0}};
 }
@@ -259,6 +265,9 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
   if (frames_done && settle_steps && settled && converged) {
     frame_ = static_cast<int>(*frames_done);
     settle_steps_ = static_cast<int>(*settle_steps);
+    // Stores written before the growth index existed grew Δt once per settling step.
+    settle_growth_ = static_cast<int>(
+        stored(kSettleGrowth).value_or(std::min(settle_steps_, kSettlingGrowthSteps)));
     settled_ = *settled != 0.0;
     level_converged_ = *converged != 0.0;
     resumed_iterations_ = iterations_in_frame;
