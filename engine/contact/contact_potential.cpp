@@ -205,8 +205,12 @@ bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
   const double reach = this->reach();
   const double clearance =
       broad_phase_.clearance(as_positions(x), reach, (1 + 2 * kMaxCertificateRadius) * reach);
-  if (!(clearance > reach)) return false;
-  certificate_ = {x, 0.5 * (clearance - reach)};
+  // Distances come from rounded coordinates: like additive_ccd's margin, 16 ε max |coordinate|
+  // keeps a pair that the candidate search would find at reach (to rounding) out of the radius.
+  const double margin = 16 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff();
+  const double radius = 0.5 * (clearance - reach - margin);
+  if (!(radius > 0)) return false;
+  certificate_ = {x, radius};
   ++stats_.certificate_renewals;
   return true;
 }

@@ -20,8 +20,8 @@
 //    their scripted motion is checked the same way.
 //  - When a state leaves the certificate and the last state had no pair within reach, one
 //    clearance query at it (capped at reach + 2 r_max) either renews the certificate there,
-//    with r = (clearance − reach)/2, or finds a pair within reach (then the candidates are
-//    searched as without the skip).
+//    with r = (clearance − reach)/2 less a rounding margin, or finds a pair within reach (then
+//    the candidates are searched as without the skip).
 //  - A step that the certificate does not cover, from a state with no pair within reach,
 //    costs one query (any_within_reach_during) and no CCD when no pair comes within reach.
 // Skipped states and steps, and the certificate's share of them, are counted in ContactStats.
