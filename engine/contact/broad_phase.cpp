@@ -448,6 +448,23 @@ struct NearAt {
   bool edge_edge(int e, int f) const { return !(at.edge_edge(e, f) > reach); }
 };
 
+/// The near test of a clearance query: keeps each thread's smallest candidate distance (a NaN
+/// one as 0) and calls a pair near when it is within `floor`, which ends the search.
+struct ClearanceAt {
+  DistanceAt at;
+  double floor;
+  tbb::enumerable_thread_specific<double>& smallest;
+
+  bool record(double distance) const {
+    const double d = std::isnan(distance) ? 0.0 : distance;
+    double& local = smallest.local();
+    local = std::min(local, d);
+    return d <= floor;
+  }
+  bool point_triangle(int v, int t) const { return record(at.point_triangle(v, t)); }
+  bool edge_edge(int e, int f) const { return record(at.edge_edge(e, f)); }
+};
+
 struct NearDuring {
   DistanceAt start, end;
   const Positions& displacement;
@@ -471,6 +488,16 @@ bool BroadPhase::any_within_reach(const Positions& x, double reach) const {
   check_vertex_count(x);
   check_finite(x, "x");
   return any_pair(ElementBoxes::at(x, *this), reach, NearAt{{x, triangles_, edges_}, reach});
+}
+
+double BroadPhase::clearance(const Positions& x, double floor, double cap) const {
+  check_vertex_count(x);
+  check_finite(x, "x");
+  tbb::enumerable_thread_specific<double> smallest(cap);
+  // A pair within the floor, when one ends the search, is in `smallest` already.
+  static_cast<void>(any_pair(ElementBoxes::at(x, *this), cap,
+                             ClearanceAt{{x, triangles_, edges_}, floor, smallest}));
+  return smallest.combine([](double a, double b) { return std::min(a, b); });
 }
 
 bool BroadPhase::any_within_reach_during(const Positions& x0, const Positions& x1,

@@ -82,6 +82,13 @@ class BroadPhase {
   /// when there is none.
   [[nodiscard]] bool any_within_reach(const Positions& x, double reach) const;
 
+  /// How far apart the surface is at x: the smallest contact distance of a pair whose boxes
+  /// come within `cap`, or `cap` when there is none (a NaN distance counts as 0). Stops at the
+  /// first pair found within `floor` ≤ cap and returns its distance, so a result ≤ floor says
+  /// only that some pair is that near. Costs a distance_candidates(x, cap) search with a
+  /// distance per candidate; with floor = reach it answers any_within_reach as well.
+  [[nodiscard]] double clearance(const Positions& x, double floor, double cap) const;
+
   /// Whether any pair may come within `reach` during the linear motion x0 → x1. A pair is
   /// ruled out by the bound d(t) ≥ max(d(0), d(1)) − max_{i,j} ‖u_i − u_j‖ (u the
   /// displacements x1 − x0, i over one element's vertices, j over the other's). False means

@@ -24,6 +24,10 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 using Gradient12 = Eigen::Matrix<double, 12, 1>;
 
+/// The largest certificate radius, in reaches: it caps the clearance query, whose cost grows
+/// with the candidates within reach + 2 r_max. See docs/contact.md for the measurements.
+constexpr double kMaxCertificateRadius = 16.0;
+
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
 
 /// The four stencil positions of a pair.
@@ -102,12 +106,37 @@ double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x) {
   return edge_edge_mollifier(c, pair.mollifier_threshold);
 }
 
+bool ClearanceCertificate::covers(const Eigen::VectorXd& x) const {
+  if (radius < 0 || x.size() != reference.size()) return false;
+  const double squared_radius = radius * radius;
+  for (Eigen::Index i = 0; i < x.size(); i += 3)
+    if (!((x.segment<3>(i) - reference.segment<3>(i)).squaredNorm() <= squared_radius))
+      return false;
+  return true;
+}
+
+bool ClearanceCertificate::covers_motion(const Eigen::VectorXd& x,
+                                         const Eigen::VectorXd& dx) const {
+  if (radius < 0 || x.size() != reference.size() || dx.size() != x.size()) return false;
+  const double squared_radius = radius * radius;
+  for (Eigen::Index i = 0; i < x.size(); i += 3) {
+    const Eigen::Vector3d start = x.segment<3>(i) - reference.segment<3>(i);
+    if (!(start.squaredNorm() <= squared_radius) ||
+        !((start + dx.segment<3>(i)).squaredNorm() <= squared_radius))
+      return false;
+  }
+  return true;
+}
+
 ContactStats& ContactStats::operator+=(const ContactStats& other) {
   barrier_evaluations += other.barrier_evaluations;
   barrier_skips += other.barrier_skips;
   ccd_evaluations += other.ccd_evaluations;
   ccd_skips += other.ccd_skips;
   ccd_pair_queries += other.ccd_pair_queries;
+  barrier_certified += other.barrier_certified;
+  ccd_certified += other.ccd_certified;
+  certificate_renewals += other.certificate_renewals;
   max_active_pairs = std::max(max_active_pairs, other.max_active_pairs);
   broad_phase_seconds += other.broad_phase_seconds;
   barrier_seconds += other.barrier_seconds;
@@ -130,21 +159,25 @@ double ContactPotential::reach() const {
 void ContactPotential::refresh(const Eigen::VectorXd& x) {
   if (cached_x_.size() == x.size() && cached_x_ == x) return;
   ++stats_.barrier_evaluations;
-  // The early-out pays only when nothing is within reach; while the last state had pairs within
-  // reach, it would find one at once and the candidates would be searched a second time.
-  const bool try_skip = parameters_.skip_when_apart && active_.empty();
+  // A clearance query pays only when nothing is within reach; while the last state had pairs
+  // within reach, it would find one at once and the candidates would be searched a second time.
+  const bool last_apart = active_.empty();
   active_.clear();
   min_distance_ = kInfinity;
   cached_x_ = x;
-  const Eigen::Map<const Positions> positions = as_positions(x);
   ContactCandidates candidates;
   {
     ScopedTimer timer(stats_.broad_phase_seconds);
-    if (try_skip && !broad_phase_.any_within_reach(positions, reach())) {
+    if (parameters_.skip_when_apart && certificate_.covers(x)) {
+      ++stats_.barrier_skips;
+      ++stats_.barrier_certified;
+      return;
+    }
+    if (parameters_.skip_when_apart && last_apart && renew_certificate(x)) {
       ++stats_.barrier_skips;
       return;
     }
-    candidates = broad_phase_.distance_candidates(positions, reach());
+    candidates = broad_phase_.distance_candidates(as_positions(x), reach());
   }
   ScopedTimer timer(stats_.barrier_seconds);
   std::vector<ContactPair> pairs = pairs_of(candidates, surface_);
@@ -166,6 +199,20 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
     min_distance_ = std::min(min_distance_, distance[k]);
   }
   stats_.max_active_pairs = std::max(stats_.max_active_pairs, static_cast<long>(active_.size()));
+}
+
+bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
+  const double reach = this->reach();
+  const double clearance =
+      broad_phase_.clearance(as_positions(x), reach, (1 + 2 * kMaxCertificateRadius) * reach);
+  // Distances come from rounded coordinates: like additive_ccd's margin, 16 ε max |coordinate|
+  // keeps a pair that the candidate search would find at reach (to rounding) out of the radius.
+  const double margin = 16 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff();
+  const double radius = 0.5 * (clearance - reach - margin);
+  if (!(radius > 0)) return false;
+  certificate_ = {x, radius};
+  ++stats_.certificate_renewals;
+  return true;
 }
 
 const std::vector<ContactPair>& ContactPotential::active_pairs(const Eigen::VectorXd& x) {
@@ -235,13 +282,19 @@ void ContactPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& blocks
 
 double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {
   ++stats_.ccd_evaluations;
+  // The state's own query (a certificate check, renewal or candidate search) is barrier time.
+  const bool apart = parameters_.skip_when_apart && active_pairs(x).empty();
   ScopedTimer timer(stats_.ccd_seconds);
+  // Nothing comes within the barrier's reach on the way, so nothing can come within ξ. (With
+  // pairs within reach at the start, neither test could succeed: they are not tried.)
+  if (apart && certificate_.covers_motion(x, dx)) {
+    ++stats_.ccd_skips;
+    ++stats_.ccd_certified;
+    return 1.0;
+  }
   const Eigen::Map<const Positions> start = as_positions(x);
   const Positions end = start + as_positions(dx);
-  // Nothing comes within the barrier's reach on the way, so nothing can come within ξ. (With
-  // pairs within reach at the start, the early-out could not succeed: it is not tried.)
-  if (parameters_.skip_when_apart && active_pairs(x).empty() &&
-      !broad_phase_.any_within_reach_during(start, end, reach())) {
+  if (apart && !broad_phase_.any_within_reach_during(start, end, reach())) {
     ++stats_.ccd_skips;
     return 1.0;
   }

@@ -9,10 +9,22 @@
 // barrier.hpp (band ξ, d̂) and m the edge–edge mollifier (threshold from the rest positions).
 // Pairs sharing a vertex and pairs of bodies the surface's rule keeps apart never enter.
 //
-// Skips (DESIGN.md §4): with `skip_when_apart`, a state with no pair within reach costs one
-// early-out query (BroadPhase::any_within_reach) and no barrier work, and a step along which no
-// pair comes within reach costs one query (any_within_reach_during) and no CCD. Both are
-// counted in ContactStats.
+// Skips (DESIGN.md §4, docs/contact.md "Skips"), all under `skip_when_apart`:
+//  - A clearance certificate (x_ref, r): one BroadPhase::clearance query found no pair within
+//    reach + 2r at x_ref. A point–triangle or edge–edge distance changes by at most 2r when
+//    every vertex moves by at most r (each point of a segment or triangle is a convex
+//    combination of its vertices), so at any x whose every vertex lies within r of its x_ref
+//    position no pair is within reach: no barrier work and no broad phase, one O(n) check.
+//    A linear step whose both ends are in that set stays in it (the set is a product of
+//    balls, which are convex): α = 1, no CCD. Colliders and pinned vertices are part of x, so
+//    their scripted motion is checked the same way.
+//  - When a state leaves the certificate and the last state had no pair within reach, one
+//    clearance query at it (capped at reach + 2 r_max) either renews the certificate there,
+//    with r = (clearance − reach)/2 less a rounding margin, or finds a pair within reach (then
+//    the candidates are searched as without the skip).
+//  - A step that the certificate does not cover, from a state with no pair within reach,
+//    costs one query (any_within_reach_during) and no CCD when no pair comes within reach.
+// Skipped states and steps, and the certificate's share of them, are counted in ContactStats.
 
 #include <Eigen/Core>
 #include <array>
@@ -47,6 +59,9 @@ struct ContactStats {
   long ccd_evaluations = 0;        ///< feasible-step queries
   long ccd_skips = 0;              ///< of those, steps on which no pair came within reach (no CCD)
   long ccd_pair_queries = 0;       ///< pair CCD queries run
+  long barrier_certified = 0;      ///< of the barrier skips, those the certificate answered
+  long ccd_certified = 0;          ///< of the CCD skips, those the certificate answered
+  long certificate_renewals = 0;   ///< clearance queries that issued a certificate
   long max_active_pairs = 0;       ///< the most pairs within reach at one state
   double broad_phase_seconds = 0;  ///< early-outs and candidate searches of the barrier
   double barrier_seconds = 0;      ///< distances, barrier values and derivatives
@@ -65,6 +80,18 @@ struct ContactPair {
 /// The constant factor of a pair's barrier at x: the edge–edge mollifier m(c(x)) of an edge–edge
 /// pair, 1 for a point–triangle pair (the barrier weight of its normal force, friction.hpp).
 double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x);
+
+/// A clearance certificate: at `reference` no pair was within reach + 2 radius, so no pair is
+/// within reach at a state whose every vertex lies within `radius` of its reference position.
+struct ClearanceCertificate {
+  Eigen::VectorXd reference;
+  double radius = -1;  ///< negative: no certificate
+
+  /// Whether every vertex of x lies within the radius of its reference position.
+  [[nodiscard]] bool covers(const Eigen::VectorXd& x) const;
+  /// Whether both ends of the linear motion x → x + dx (and so all of it) are covered.
+  [[nodiscard]] bool covers_motion(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) const;
+};
 
 class ContactPotential {
  public:
@@ -100,11 +127,15 @@ class ContactPotential {
   /// already conservative: the gap keeps at least ccd.ratio_bound of its start value).
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx);
 
+  /// The clearance certificate of the skips (radius < 0 while there is none).
+  [[nodiscard]] const ClearanceCertificate& certificate() const { return certificate_; }
+
   [[nodiscard]] const ContactStats& stats() const { return stats_; }
   void reset_stats() { stats_ = ContactStats{}; }
 
  private:
   void refresh(const Eigen::VectorXd& x);
+  bool renew_certificate(const Eigen::VectorXd& x);
   void accumulate_gradient(const Eigen::VectorXd& x, double scale, Eigen::VectorXd& g);
 
   ContactSurface surface_;
@@ -116,6 +147,7 @@ class ContactPotential {
   Eigen::VectorXd cached_x_;
   std::vector<ContactPair> active_;
   double min_distance_ = 0;
+  ClearanceCertificate certificate_;
 };
 
 }  // namespace psq

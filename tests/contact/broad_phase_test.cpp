@@ -307,6 +307,21 @@ TEST(BroadPhase, EarlyOutAgreesWithTheClosestPairDistance) {
   }
 }
 
+TEST(BroadPhase, ClearanceIsTheClosestPairDistanceUpToItsCap) {
+  std::mt19937 rng(23);
+  std::vector<Surface> surfaces{triangle_soup(100, 0.01, rng), perturbed_sheets(rng)};
+  for (const Surface& s : surfaces) {
+    const double closest = closest_pair_distance(s, s.x);
+    ASSERT_GT(closest, 0.0);
+    const BroadPhase broad = broad_phase_of(s);
+    EXPECT_NEAR(broad.clearance(s.x, 0.0, 10 * closest), closest, 1e-9 * closest);
+    EXPECT_NEAR(broad.clearance(s.x, 0.99 * closest, 1.01 * closest), closest, 1e-9 * closest);
+    EXPECT_EQ(broad.clearance(s.x, 0.0, 0.99 * closest), 0.99 * closest);
+    // A pair within the floor ends the search: the answer only says that one is that near.
+    EXPECT_LE(broad.clearance(s.x, 2 * closest, 10 * closest), 2 * closest);
+  }
+}
+
 TEST(BroadPhase, FlatSheetNeighboursHaveBoxesInReachButNoDistance) {
   SheetGenerator spec;
   spec.edge_length = 0.05;
@@ -396,6 +411,7 @@ TEST(BroadPhase, NonFinitePositionIsANumericalError) {
   EXPECT_THROW((void)broad.distance_candidates(bad, 0.01), NumericalError);
   EXPECT_THROW((void)broad.swept_candidates(s.x, bad, 0.01), NumericalError);
   EXPECT_THROW((void)broad.any_within_reach(bad, 0.01), NumericalError);
+  EXPECT_THROW((void)broad.clearance(bad, 0.01, 0.1), NumericalError);
   EXPECT_THROW((void)overlapping_triangle_boxes(bad, s.triangles), NumericalError);
 }
 

@@ -8,6 +8,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
@@ -15,6 +17,7 @@
 #include "engine/mesh/topology.hpp"
 #include "support/derivative_check.hpp"
 #include "support/finite_difference.hpp"
+#include "support/random_geometry.hpp"
 
 namespace psq {
 namespace {
@@ -189,6 +192,157 @@ TEST(ContactPotential, SkipsTheCcdWhenNothingComesWithinReach) {
     EXPECT_EQ(contact.stats().ccd_evaluations, 1);
     EXPECT_EQ(contact.stats().ccd_skips, skip ? 1 : 0);
   }
+}
+
+/// The upper sheet (body 1) of `sheets` moved by `offset`, the lower one left in place.
+Eigen::VectorXd upper_moved(const TwoSheets& sheets, const Eigen::Vector3d& offset) {
+  Eigen::VectorXd x = sheets.x;
+  for (Eigen::Index v = sheets.lower_vertices; v < x.size() / 3; ++v) x.segment<3>(3 * v) += offset;
+  return x;
+}
+
+TEST(ContactPotential, CertificateAnswersStatesAndStepsNearItsReference) {
+  // Parallel sheets 5 d̂ apart, nothing else in reach: the certificate radius is (5 − 1) d̂ / 2.
+  const TwoSheets sheets = two_sheets(5 * kActivation);
+  ContactPotential contact(sheets.surface, parameters());
+  EXPECT_EQ(contact.value(sheets.x), 0.0);
+  EXPECT_EQ(contact.stats().certificate_renewals, 1);
+  EXPECT_NEAR(contact.certificate().radius, 2 * kActivation, 1e-12);
+
+  // Within the radius: no broad phase, no barrier, no CCD.
+  const Eigen::VectorXd near_reference = upper_moved(sheets, {0.0, 0.0, -1.9 * kActivation});
+  EXPECT_EQ(contact.value(near_reference), 0.0);
+  const Eigen::VectorXd slide = upper_moved(sheets, {0.5 * kActivation, 0.0, 0.0}) - sheets.x;
+  EXPECT_EQ(contact.max_feasible_step(near_reference, slide), 1.0);
+  EXPECT_EQ(contact.stats().barrier_evaluations, 2);
+  EXPECT_EQ(contact.stats().barrier_certified, 1);
+  EXPECT_EQ(contact.stats().ccd_certified, 1);
+  EXPECT_EQ(contact.stats().certificate_renewals, 1);
+
+  // A step ending outside the radius is not the certificate's to answer, though it is safe.
+  const Eigen::VectorXd long_slide = upper_moved(sheets, {0.02, 0.0, 0.0}) - sheets.x;
+  EXPECT_EQ(contact.max_feasible_step(near_reference, long_slide), 1.0);
+  EXPECT_EQ(contact.stats().ccd_certified, 1);
+  EXPECT_EQ(contact.stats().ccd_skips, 2);
+}
+
+TEST(ContactPotential, CertificateIsRenewedWhereAStateLeavesIt) {
+  const TwoSheets sheets = two_sheets(9 * kActivation);
+  ContactPotential contact(sheets.surface, parameters());
+  EXPECT_EQ(contact.value(sheets.x), 0.0);
+  EXPECT_NEAR(contact.certificate().radius, 4 * kActivation, 1e-12);
+  // 5 d̂ down leaves the first certificate; 3 d̂ apart, the new one has radius d̂.
+  const Eigen::VectorXd lower = upper_moved(sheets, {0.0, 0.0, -6 * kActivation});
+  EXPECT_EQ(contact.value(lower), 0.0);
+  EXPECT_EQ(contact.stats().certificate_renewals, 2);
+  EXPECT_EQ(contact.stats().barrier_certified, 0);
+  EXPECT_EQ(contact.certificate().reference, lower);
+  EXPECT_NEAR(contact.certificate().radius, kActivation, 1e-12);
+}
+
+TEST(ContactPotential, CertificateDoesNotHoldWhenPairsAreNear) {
+  // 3 d̂ apart: radius d̂. Then 2.5 d̂ down, beyond the radius and into reach.
+  const TwoSheets sheets = two_sheets(3 * kActivation);
+  ContactPotential contact(sheets.surface, parameters());
+  ContactPotential reference(sheets.surface, parameters(false));
+  EXPECT_EQ(contact.value(sheets.x), 0.0);
+  const Eigen::VectorXd near = upper_moved(sheets, {0.0, 0.0, -2.5 * kActivation});
+  EXPECT_FALSE(contact.certificate().covers(near));
+  EXPECT_GT(contact.value(near), 0.0);
+  EXPECT_NEAR(contact.value(near), reference.value(near), 1e-12 * reference.value(near));
+  EXPECT_EQ(contact.active_pairs(near).size(), reference.active_pairs(near).size());
+  EXPECT_EQ(contact.stats().barrier_certified, 0);
+  EXPECT_EQ(contact.stats().certificate_renewals, 1);
+  // A surface that starts within reach gets no certificate.
+  const TwoSheets touching = two_sheets(0.5 * kActivation);
+  ContactPotential in_contact(touching.surface, parameters());
+  EXPECT_GT(in_contact.value(touching.x), 0.0);
+  EXPECT_LT(in_contact.certificate().radius, 0.0);
+  EXPECT_EQ(in_contact.stats().certificate_renewals, 0);
+}
+
+/// A random motion of every vertex: coordinates uniform in [−size, size].
+Eigen::VectorXd random_motion(Eigen::Index size_of_x, double size, std::mt19937& rng) {
+  Eigen::VectorXd dx(size_of_x);
+  for (Eigen::Index i = 0; i < size_of_x; i += 3) dx.segment<3>(i) = size * test::random_point(rng);
+  return dx;
+}
+
+void expect_same_pairs(const std::vector<ContactPair>& a, const std::vector<ContactPair>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].vertices, b[k].vertices);
+    EXPECT_EQ(a[k].edge_edge, b[k].edge_edge);
+  }
+}
+
+TEST(ContactPotential, SkipsChangeNothingAlongRandomMotions) {
+  // Noisy sheets 6 d̂ apart, pushed together by random motions (small ones like late Newton
+  // steps, large ones like early ones) plus a downward drift of the upper sheet, each step cut
+  // to the CCD-safe fraction: states far apart, approaching and in contact.
+  ContactStats with_skips;
+  int longer_steps = 0;
+  for (const unsigned seed : {3u, 5u, 8u}) {
+    std::mt19937 rng(seed);
+    TwoSheets sheets = two_sheets(6 * kActivation);
+    for (Eigen::Index i = 2; i < sheets.x.size(); i += 3)
+      sheets.x[i] += 0.3 * kActivation * test::random_point(rng).z();
+    ContactParameters with_thickness = parameters();
+    with_thickness.band.thickness = 0.2 * kActivation;
+    ContactPotential skipping(sheets.surface, with_thickness);
+    with_thickness.skip_when_apart = false;
+    ContactPotential searching(sheets.surface, with_thickness);
+    ContactPotential checking(sheets.surface, with_thickness);
+    skipping.set_stiffness(1e3);
+    searching.set_stiffness(1e3);
+    const Eigen::VectorXd drift = upper_moved(sheets, {0.0, 0.0, -0.3 * kActivation}) - sheets.x;
+    std::uniform_real_distribution<double> size_exponent(-2.0, 0.5);
+    Eigen::VectorXd x = sheets.x;
+    for (int step = 0; step < 60; ++step) {
+      expect_same_pairs(skipping.active_pairs(x), searching.active_pairs(x));
+      const double value = searching.value(x);
+      EXPECT_NEAR(skipping.value(x), value, 1e-12 * value) << step;
+      Eigen::VectorXd g_skipping = Eigen::VectorXd::Zero(x.size());
+      Eigen::VectorXd g_searching = Eigen::VectorXd::Zero(x.size());
+      skipping.add_gradient(x, g_skipping);
+      searching.add_gradient(x, g_searching);
+      EXPECT_EQ(g_skipping, g_searching) << step;
+
+      const double size = kActivation * std::pow(10.0, size_exponent(rng));
+      const Eigen::VectorXd dx = drift + random_motion(x.size(), size, rng);
+      const long skips_before = skipping.stats().ccd_skips;
+      const double alpha_skipping = skipping.max_feasible_step(x, dx);
+      const double alpha_searching = searching.max_feasible_step(x, dx);
+      if (skipping.stats().ccd_skips == skips_before) {
+        EXPECT_EQ(alpha_skipping, alpha_searching) << step;
+      } else {
+        // A skipped step is the whole step, and nothing comes within reach along it (the
+        // CCD's ratio bound may still cut a fast approach of pairs far apart).
+        EXPECT_EQ(alpha_skipping, 1.0);
+        EXPECT_GE(alpha_skipping, alpha_searching);
+        longer_steps += alpha_skipping > alpha_searching;
+        for (double t = 0; t <= 1.0; t += 0.125)
+          EXPECT_TRUE(checking.active_pairs(x + t * dx).empty()) << step << " " << t;
+      }
+      // A line-search trial at half the step, then the step itself (CCD-safe for both).
+      const double alpha = 0.9 * std::min(alpha_skipping, alpha_searching);
+      EXPECT_NEAR(skipping.value(x + 0.5 * alpha * dx), searching.value(x + 0.5 * alpha * dx),
+                  1e-12 * searching.value(x + 0.5 * alpha * dx));
+      x += alpha * dx;
+    }
+    EXPECT_GT(searching.stats().max_active_pairs, 0);
+    with_skips += skipping.stats();
+  }
+  // Every kind of state was met: certified ones, renewals, and searches in contact.
+  EXPECT_GT(with_skips.barrier_certified, 0);
+  EXPECT_GT(with_skips.ccd_certified, 0);
+  EXPECT_GT(with_skips.certificate_renewals, 3);
+  EXPECT_LT(with_skips.barrier_skips, with_skips.barrier_evaluations);
+  std::printf(
+      "random motions: %ld of %ld states certified, %ld renewals, %ld of %ld steps "
+      "certified, %d skipped steps longer than the CCD's\n",
+      with_skips.barrier_certified, with_skips.barrier_evaluations, with_skips.certificate_renewals,
+      with_skips.ccd_certified, with_skips.ccd_evaluations, longer_steps);
 }
 
 TEST(ContactPotential, RejectsBadParameters) {
