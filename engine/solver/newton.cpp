@@ -17,6 +17,14 @@ constexpr double kFirstRelativeShift = 1e-8;
 constexpr double kShiftGrowth = 10.0;
 constexpr int kShiftAttempts = 9;
 
+/// A full step that lowers E by more than this fraction of the linear prediction −gᵀd (an exact
+/// quadratic model predicts ½) met much less curvature than K promised: the projected Hessian
+/// overestimates it where the energy is not convex (a sheet snapping through a twist), and full
+/// steps are then short. Only such steps try longer ones.
+constexpr double kExtrapolationTrigger = 0.75;
+/// Longer steps tried after such a full step: α = 2, 4, … up to this.
+constexpr double kMaxExtrapolation = 64.0;
+
 /// Energy changes smaller than this fraction of |E| are below the rounding of E itself, so
 /// the Armijo test does not reject a step for them (it would stall a converging solve).
 constexpr double kEnergyRoundoff = 1e-12;
@@ -191,9 +199,14 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
     ++record.line_search_trials;
     const double bound = energy + settings.armijo * alpha * slope + slack;
     if (std::isfinite(trial_energy) && trial_energy <= bound) {
-      x.swap(trial_);
       record.step_length = alpha;
-      return trial_energy;
+      const bool underestimated =
+          alpha == 1.0 && trial_energy - energy < kExtrapolationTrigger * slope;
+      const double accepted = underestimated
+                                  ? extrapolate(objective, x, direction, trial_energy, record)
+                                  : trial_energy;
+      x.swap(trial_);
+      return accepted;
     }
   }
   throw NumericalError(fmt::format(
@@ -201,6 +214,24 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
       "E = {:.12e})",
       record.iteration, record.gradient_norm, record.feasible_step, record.line_search_trials,
       energy));
+}
+
+double NewtonSolver::extrapolate(Objective& objective, const Eigen::VectorXd& x,
+                                 const Eigen::VectorXd& direction, double full_step_energy,
+                                 NewtonIteration& record) {
+  double accepted = full_step_energy;
+  for (double alpha = 2.0; alpha <= kMaxExtrapolation; alpha *= 2.0) {
+    // The CCD is asked about the whole longer motion: the full step's check does not cover it.
+    if (objective.max_feasible_step(x, alpha * direction) < 1.0) break;
+    longer_trial_ = x + alpha * direction;
+    const double longer_energy = objective.value(longer_trial_);
+    ++record.line_search_trials;
+    if (!(std::isfinite(longer_energy) && longer_energy < accepted)) break;
+    accepted = longer_energy;
+    record.step_length = alpha;
+    trial_.swap(longer_trial_);
+  }
+  return accepted;
 }
 
 NewtonSolver::Progress offset_progress(NewtonSolver::Progress progress, const int& offset) {

@@ -28,7 +28,9 @@ struct NewtonSettings {
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected
 /// Hessian blocks, sparse assembly, Cholesky, direction d = −K⁻¹g (with a diagonal shift, then
 /// the negative gradient, as fallbacks when K is not positive definite or d is not a descent
-/// direction), first trial step α = min(1, max_feasible_step(x, d)), Armijo backtracking.
+/// direction), first trial step α = min(1, max_feasible_step(x, d)), Armijo backtracking; a
+/// full step that lowers E far more than the quadratic model predicts is extended (α = 2, 4, …)
+/// while E keeps decreasing and the CCD allows the motion.
 class NewtonSolver {
  public:
   using Progress = std::function<void(const NewtonIteration&)>;
@@ -59,10 +61,19 @@ class NewtonSolver {
                      double energy, double slope, const NewtonSettings& settings,
                      NewtonIteration& record);
 
+  /// After an accepted full step whose energy drop shows K overestimating the curvature: tries
+  /// α = 2, 4, … (up to 64) along d while the CCD finds the whole motion from x safe
+  /// and E keeps decreasing, leaving the best point in trial_ (which holds x + d on entry) and
+  /// its α in record.step_length; returns its energy.
+  double extrapolate(Objective& objective, const Eigen::VectorXd& x,
+                     const Eigen::VectorXd& direction, double full_step_energy,
+                     NewtonIteration& record);
+
   HessianBlocks hessian_;
   SparseAssembler assembler_;
   CholmodSolver cholmod_;
   Eigen::VectorXd trial_;
+  Eigen::VectorXd longer_trial_;
 };
 
 /// `progress` with every iteration number shifted by `offset` (read at each call, so it may

@@ -36,15 +36,16 @@ enum class DirectionKind {
 /// final energy, gradient norm and step norm, and takes no step (step_length = 0).
 struct NewtonIteration {
   int iteration = 0;
-  double energy = 0.0;             ///< E(x) at the start of the iteration
-  double gradient_norm = 0.0;      ///< ‖∇E(x)‖₂ over the free DOFs
-  double step_norm = 0.0;          ///< ‖d‖∞ / step_scale for the full direction d
-  double step_length = 0.0;        ///< accepted α (0 when no step was taken)
-  double feasible_step = 0.0;      ///< first trial α = min(1, max_feasible_step(x, d))
-  int line_search_trials = 0;      ///< objective values evaluated by the line search
+  double energy = 0.0;         ///< E(x) at the start of the iteration
+  double gradient_norm = 0.0;  ///< ‖∇E(x)‖₂ over the free DOFs
+  double step_norm = 0.0;      ///< ‖d‖∞ / step_scale for the full direction d
+  /// Accepted α: 0 when no step was taken, above 1 when a full step was extended.
+  double step_length = 0.0;
+  double feasible_step = 0.0;  ///< first trial α = min(1, max_feasible_step(x, d))
+  int line_search_trials = 0;  ///< objective values evaluated by the line search
   DirectionKind direction = DirectionKind::newton;
-  double shift = 0.0;              ///< σ when direction == shifted_newton
-  bool pattern_changed = false;    ///< the sparsity pattern changed, so it was re-analyzed
+  double shift = 0.0;            ///< σ when direction == shifted_newton
+  bool pattern_changed = false;  ///< the sparsity pattern changed, so it was re-analyzed
   PhaseTimes times;
 };
 

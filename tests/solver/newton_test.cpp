@@ -339,9 +339,9 @@ TEST(Newton, StatisticsAddUp) {
   SpringChain chain = problem.objective();
   NewtonSolver solver;
   std::vector<NewtonIteration> reported;
-  const NewtonResult result = solver.minimize(
-      chain, problem.x, problem.dofs, tight_settings(),
-      [&](const NewtonIteration& record) { reported.push_back(record); });
+  const NewtonResult result =
+      solver.minimize(chain, problem.x, problem.dofs, tight_settings(),
+                      [&](const NewtonIteration& record) { reported.push_back(record); });
   ASSERT_EQ(reported.size(), result.history.size());
   PhaseTimes sum;
   for (std::size_t k = 0; k < reported.size(); ++k) {
@@ -436,6 +436,38 @@ TEST(Newton, RespectsMaxFeasibleStep) {
     EXPECT_LE(record.step_length, record.feasible_step);
   for (std::size_t k = 1; k < probe.iterates.size(); ++k)
     EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.25 + 1e-15);
+}
+
+// A Hessian 100 times too stiff (as a PSD projection can make it where E is not convex) gives
+// full steps 1/100 of the way: they are extended to α = 64 while E keeps decreasing.
+TEST(Newton, ExtendsFullStepsWhereHessianOverestimatesCurvature) {
+  ProbeQuadratic probe(3, -2.0);
+  probe.hessian_diagonal = 100.0;
+  const DofMap dofs(1, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  ASSERT_TRUE(result.converged);
+  // The tolerance bounds d = −g/100, so the error is within 100 × 1e-10.
+  EXPECT_LT((x.array() + 2.0).abs().maxCoeff(), 1e-8);
+  EXPECT_EQ(result.history[0].step_length, 64.0);
+  // Without extension: ‖x + 2‖ shrinks by 0.99 per step, about 2800 steps to 1e-12.
+  EXPECT_LE(result.iterations, 20);
+}
+
+// The extension asks the CCD about the whole longer motion: it stops at the last α whose
+// displacement the feasible-step bound allows.
+TEST(Newton, ExtensionRespectsMaxFeasibleStep) {
+  ProbeQuadratic probe(3, -2.0);
+  probe.hessian_diagonal = 100.0;
+  probe.max_displacement = 0.1;  // d = −0.02 per coordinate: α = 4 moves 0.08, α = 8 0.16
+  const DofMap dofs(1, {});
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  EXPECT_EQ(result.history[0].step_length, 4.0);
+  for (std::size_t k = 1; k < probe.iterates.size(); ++k)
+    EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.1 + 1e-15);
 }
 
 TEST(Newton, LineSearchFailureIsReported) {
