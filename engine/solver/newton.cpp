@@ -24,6 +24,10 @@ constexpr int kShiftAttempts = 9;
 constexpr double kExtrapolationTrigger = 0.75;
 /// Longer steps tried after such a full step: α = 2, 4, … up to this.
 constexpr double kMaxExtrapolation = 64.0;
+/// Full steps predicted to lower E by less than this fraction of |E| are never extended: their
+/// measured decrease is mostly rounding of E, and extending on it (α up to 64) throws a
+/// converging solve off (a static cantilever at tolerance 1e-9 m stalled at 100 iterations).
+constexpr double kExtrapolationFloor = 1e-9;
 
 /// Energy changes smaller than this fraction of |E| are below the rounding of E itself, so
 /// the Armijo test does not reject a step for them (it would stall a converging solve).
@@ -200,8 +204,9 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
     const double bound = energy + settings.armijo * alpha * slope + slack;
     if (std::isfinite(trial_energy) && trial_energy <= bound) {
       record.step_length = alpha;
-      const bool underestimated =
-          alpha == 1.0 && trial_energy - energy < kExtrapolationTrigger * slope;
+      const bool underestimated = alpha == 1.0 &&
+                                  -slope > kExtrapolationFloor * std::abs(energy) &&
+                                  trial_energy - energy < kExtrapolationTrigger * slope;
       const double accepted = underestimated
                                   ? extrapolate(objective, x, direction, trial_energy, record)
                                   : trial_energy;

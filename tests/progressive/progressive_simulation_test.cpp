@@ -66,9 +66,10 @@ TEST(ProgressiveSimulation, RefusesAStrainLimitedSceneNamingTheKey) {
 
 /// Runs `sim` (two levels) through, then a direct fine solve and a direct solve of the coarsest
 /// mesh with its own elastics; asserts the finest answer within 1e-3 × bbox diagonal of the
-/// direct fine one, and the coarsest preview, prolonged, closer to it than the direct coarse
-/// answer prolonged by the same P^0. Prints the errors.
-void compare_with_direct_solves(const Scene& scene, ProgressiveSimulation& sim) {
+/// direct fine one, and the coarsest preview, prolonged, closer to it than `preview_factor` ×
+/// the direct coarse answer's error (prolonged by the same P^0). Prints the errors.
+void compare_with_direct_solves(const Scene& scene, ProgressiveSimulation& sim,
+                                double preview_factor = 1.0) {
   ASSERT_EQ(sim.level_count(), 2);
   run_level(sim);
   EXPECT_TRUE(sim.level_converged());
@@ -99,28 +100,35 @@ void compare_with_direct_solves(const Scene& scene, ProgressiveSimulation& sim) 
             << "progressive finest " << final_error / diagonal << ", level-0 preview "
             << preview_error / diagonal << ", direct coarse " << coarse_error / diagonal << "\n";
   EXPECT_LT(final_error, 1e-3 * diagonal);
-  EXPECT_LT(preview_error, coarse_error);
+  EXPECT_LT(preview_error, preview_factor * coarse_error);
 }
 
-void compare_with_direct_solves(const test::NestedCase& c) {
+void compare_with_direct_solves(const test::NestedCase& c, double preview_factor = 1.0) {
   ProgressiveSimulation sim(c.scene, two_levels(c.scene), {c.hierarchy});
-  compare_with_direct_solves(c.scene, sim);
+  compare_with_direct_solves(c.scene, sim, preview_factor);
 }
 
-TEST(ProgressiveSimulation, DrapeMatchesDirectFineAndPreviewBeatsDirectCoarse) {
-  compare_with_direct_solves(test::nested_case("drape", 10));
+/// The flat drape's preview is only as close as the direct coarse simulation: here the two
+/// errors agree to 0.2 % (which is ahead moves with the solver's rounding), and on decimated
+/// hierarchies at 5k and 20k vertices the preview is behind (bench_progressive; issue 4 notes).
+/// Prolonged linearly across a flat coarse mesh, the fine hinges see the coarse creases whole,
+/// so the preview bends stiffer than the cloth. The bound is a tie, not a win.
+constexpr double kDrapePreviewTie = 1.01;
+
+TEST(ProgressiveSimulation, DrapeMatchesDirectFineAndPreviewTiesDirectCoarse) {
+  compare_with_direct_solves(test::nested_case("drape", 10), kDrapePreviewTie);
 }
 
 TEST(ProgressiveSimulation, TwistMatchesDirectFineAndPreviewBeatsDirectCoarse) {
   compare_with_direct_solves(test::nested_case("twist", 10));
 }
 
-TEST(ProgressiveSimulation, MidedgeDrapeMatchesDirectFineAndPreviewBeatsDirectCoarse) {
+TEST(ProgressiveSimulation, MidedgeDrapeMatchesDirectFineAndPreviewTiesDirectCoarse) {
   // Every level's system bends with the scene's model: the coarse level's mid-edge faces in the
   // preview and Hessian, the finest level's in the proxy's energy and gradient.
   test::NestedCase drape = test::nested_case("drape", 10);
   drape.scene.shells[0].bending = BendingModel::midedge;
-  compare_with_direct_solves(drape);
+  compare_with_direct_solves(drape, kDrapePreviewTie);
 }
 
 TEST(ProgressiveSimulation, CylinderMatchesDirectFineAndPreviewBeatsDirectCoarse) {
