@@ -63,6 +63,9 @@ TEST(SimCommand, ContactScenesReportTheirContactAndFrictionPerFrame) {
     EXPECT_GT(frame["contact"]["max_active_pairs"].get<long>(), 0);
     EXPECT_GT(frame["contact"]["barrier_stiffness"].get<double>(), 0.0);
     EXPECT_GT(frame["contact"]["barrier_evaluations"].get<long>(), 0);
+    // In contact throughout: nothing is ever certified clear.
+    EXPECT_EQ(frame["contact"]["barrier_certified"].get<long>(), 0);
+    EXPECT_EQ(frame["contact"]["ccd_certified"].get<long>(), 0);
     EXPECT_GE(frame["friction_iterations"].get<int>(), 2);
   }
 }
