@@ -12,13 +12,16 @@
 #include "engine/core/error.hpp"
 
 namespace psq {
+double distance_rounding_margin(double largest_coordinate) {
+  // Multiple of ε_mach · max |coordinate| that covers the rounding of the positions and of the
+  // distance computation.
+  constexpr double kRoundingMarginFactor = 16.0;
+  return kRoundingMarginFactor * std::numeric_limits<double>::epsilon() * largest_coordinate;
+}
+
 namespace {
 
 using Eigen::Vector3d;
-
-/// Multiple of ε_mach · max |coordinate| by which the contact distance ξ is enlarged to cover
-/// the rounding of the positions and of the distance computation.
-constexpr double kRoundingMarginFactor = 16.0;
 
 /// Displacements end − start without their mean (a common translation leaves distances alone).
 PairPositions relative_displacements(const PairPositions& start, const PairPositions& end) {
@@ -33,8 +36,8 @@ PairPositions relative_displacements(const PairPositions& start, const PairPosit
   return displacement;
 }
 
-/// δ = 16 ε max |coordinate|. A non-finite position is a NumericalError: it must not pass as
-/// either safe or colliding.
+/// distance_rounding_margin of the pair's positions at both ends. A non-finite position is a
+/// NumericalError: it must not pass as either safe or colliding.
 double rounding_margin(const PairPositions& start, const PairPositions& end) {
   double largest = 0;
   for (int i = 0; i < 4; ++i) {
@@ -42,7 +45,7 @@ double rounding_margin(const PairPositions& start, const PairPositions& end) {
       throw NumericalError("additive CCD: a vertex position is not finite (NaN or infinity)");
     largest = std::max({largest, start[i].cwiseAbs().maxCoeff(), end[i].cwiseAbs().maxCoeff()});
   }
-  return kRoundingMarginFactor * std::numeric_limits<double>::epsilon() * largest;
+  return distance_rounding_margin(largest);
 }
 
 /// The conservative-advancement loop shared by both pair types. `distance` maps the four

@@ -33,6 +33,11 @@ namespace psq {
 /// edge–edge (a0, a1, b0, b1).
 using PairPositions = std::array<Eigen::Vector3d, 4>;
 
+/// δ = 16 ε max |coordinate|: how far rounding of positions with coordinates up to
+/// `largest_coordinate` (in absolute value) and of a distance computed from them may move a
+/// pair distance. The CCD enlarges ξ by it; the contact skips shrink their clearance by it.
+double distance_rounding_margin(double largest_coordinate);
+
 /// Parameters of the additive CCD. The defaults are those of Li et al. (s = 0.9, r = 0.1).
 struct AdditiveCcdSettings {
   /// s ∈ (0, 1): the fraction of the guaranteed-safe time (d − ξ)/l_p taken per advance

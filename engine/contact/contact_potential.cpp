@@ -205,9 +205,9 @@ bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
   const double reach = this->reach();
   const double clearance =
       broad_phase_.clearance(as_positions(x), reach, (1 + 2 * kMaxCertificateRadius) * reach);
-  // Distances come from rounded coordinates: like additive_ccd's margin, 16 ε max |coordinate|
-  // keeps a pair that the candidate search would find at reach (to rounding) out of the radius.
-  const double margin = 16 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff();
+  // Distances come from rounded coordinates: the margin keeps a pair that the candidate search
+  // would find at reach (to rounding) out of the radius.
+  const double margin = distance_rounding_margin(x.cwiseAbs().maxCoeff());
   const double radius = 0.5 * (clearance - reach - margin);
   if (!(radius > 0)) return false;
   certificate_ = {x, radius};
