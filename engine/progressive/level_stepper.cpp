@@ -20,6 +20,11 @@ bool settling_done(int settle_step, double change, double tolerance) {
   return settle_step >= kSettlingGrowthSteps && change < tolerance;
 }
 
+int next_settling_growth(int growth, const NewtonResult& newton) {
+  const bool nothing_to_solve = newton.converged && newton.iterations == 0;
+  return nothing_to_solve ? std::max(growth + 1, kSettlingGrowthSteps) : growth + 1;
+}
+
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
                                const NewtonSolver::Progress& progress) {
   return step(x, frame, system_.scene().time.step, progress);

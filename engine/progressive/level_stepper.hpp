@@ -21,6 +21,11 @@ inline constexpr int kSettlingGrowthSteps = 6;
 /// ‖x − xᵗ‖∞/Δt is below the tolerance: only then is a small change a small distance to the
 /// equilibrium.
 bool settling_done(int settle_step, double change, double tolerance);
+/// The settling time step index after a step at index `growth` solved by `newton`: one more,
+/// or kSettlingGrowthSteps at once when that step had nothing to solve (converged at its start)
+/// — the inertia-like term no longer held anything back, and growing Δt 4× at a time would only
+/// cost one more Hessian and factorization per step.
+int next_settling_growth(int growth, const NewtonResult& newton);
 
 class LevelStepper {
  public:

@@ -202,9 +202,7 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   if (out.settling) {
     level_converged_ = settling_done(settle_growth_, out.change, tolerance());
     ++settle_steps_;
-    const bool nothing_to_solve = out.frame.newton.converged && out.frame.newton.iterations == 0;
-    settle_growth_ =
-        nothing_to_solve ? std::max(settle_growth_ + 1, kSettlingGrowthSteps) : settle_growth_ + 1;
+    settle_growth_ = next_settling_growth(settle_growth_, out.frame.newton);
     settled_ = level_converged_ || settle_steps_ >= settings_.max_settle_steps;
   }
   return out;

@@ -147,10 +147,7 @@ class ProgressiveSimulation {
   bool settled_ = false;
   bool level_converged_ = false;
   int settle_steps_ = 0;
-  /// Index of the settling time step (settling_time_step): the settling steps taken, or
-  /// kSettlingGrowthSteps once a settling step needed no Newton iteration — its Newton step
-  /// was already within the tolerance, so the inertia-like term no longer holds anything back and
-  /// growing Δt 4× at a time would only cost one more Hessian and factorization per step.
+  /// Index of the settling time step (settling_time_step, next_settling_growth).
   int settle_growth_ = 0;
   /// Newton iterations already taken in the next step before a restore (0: start it afresh).
   int resumed_iterations_ = 0;
