@@ -441,13 +441,6 @@ struct DistanceAt {
   }
 };
 
-struct NearAt {
-  DistanceAt at;
-  double reach;
-  bool point_triangle(int v, int t) const { return !(at.point_triangle(v, t) > reach); }
-  bool edge_edge(int e, int f) const { return !(at.edge_edge(e, f) > reach); }
-};
-
 /// The near test of a clearance query: keeps each thread's smallest candidate distance (a NaN
 /// one as 0) and calls a pair near when it is within `floor`, which ends the search.
 struct ClearanceAt {
@@ -483,12 +476,6 @@ struct NearDuring {
 };
 
 }  // namespace
-
-bool BroadPhase::any_within_reach(const Positions& x, double reach) const {
-  check_vertex_count(x);
-  check_finite(x, "x");
-  return any_pair(ElementBoxes::at(x, *this), reach, NearAt{{x, triangles_, edges_}, reach});
-}
 
 double BroadPhase::clearance(const Positions& x, double floor, double cap) const {
   check_vertex_count(x);

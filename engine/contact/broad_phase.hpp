@@ -75,18 +75,13 @@ class BroadPhase {
   [[nodiscard]] ContactCandidates swept_candidates(const Positions& x0, const Positions& x1,
                                                    double reach) const;
 
-  /// Whether any pair lies within `reach` at x, by the contact distances of the box
-  /// candidates (point_triangle_distance, edge_edge_distance), so that neighbouring elements
-  /// of a flat sheet, whose boxes touch, do not count. False means that no barrier term is
-  /// active at x. Stops at the first pair found; costs about a distance_candidates call
-  /// when there is none.
-  [[nodiscard]] bool any_within_reach(const Positions& x, double reach) const;
-
-  /// How far apart the surface is at x: the smallest contact distance of a pair whose boxes
-  /// come within `cap`, or `cap` when there is none (a NaN distance counts as 0). Stops at the
-  /// first pair found within `floor` ≤ cap and returns its distance, so a result ≤ floor says
-  /// only that some pair is that near. Costs a distance_candidates(x, cap) search with a
-  /// distance per candidate; with floor = reach it answers any_within_reach as well.
+  /// How far apart the surface is at x: the smallest contact distance (point_triangle_distance,
+  /// edge_edge_distance, so that neighbouring elements of a flat sheet, whose boxes touch, do
+  /// not count) of a pair whose boxes come within `cap`, or `cap` when there is none (a NaN
+  /// distance counts as 0). Stops at the first pair found within `floor` ≤ cap and returns its
+  /// distance, so a result ≤ floor says only that some pair is that near: with floor = reach
+  /// < cap, a result above reach means no barrier term is active at x. Costs a
+  /// distance_candidates(x, cap) search with a distance per candidate.
   [[nodiscard]] double clearance(const Positions& x, double floor, double cap) const;
 
   /// Whether any pair may come within `reach` during the linear motion x0 → x1. A pair is

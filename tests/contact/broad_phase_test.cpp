@@ -299,8 +299,9 @@ TEST(BroadPhase, EarlyOutAgreesWithTheClosestPairDistance) {
     const double closest = closest_pair_distance(s, s.x);
     ASSERT_GT(closest, 0.0);
     const BroadPhase broad = broad_phase_of(s);
-    EXPECT_FALSE(broad.any_within_reach(s.x, 0.99 * closest)) << closest;
-    EXPECT_TRUE(broad.any_within_reach(s.x, 1.01 * closest)) << closest;
+    // "Any pair within r": a clearance with floor r below its cap is at most r.
+    EXPECT_GT(broad.clearance(s.x, 0.99 * closest, 2 * closest), 0.99 * closest) << closest;
+    EXPECT_LE(broad.clearance(s.x, 1.01 * closest, 2 * closest), 1.01 * closest) << closest;
     // A motion that does not move anything is the state itself.
     EXPECT_FALSE(broad.any_within_reach_during(s.x, s.x, 0.99 * closest)) << closest;
     EXPECT_TRUE(broad.any_within_reach_during(s.x, s.x, 1.01 * closest)) << closest;
@@ -331,10 +332,11 @@ TEST(BroadPhase, FlatSheetNeighboursHaveBoxesInReachButNoDistance) {
   const BroadPhase broad = broad_phase_of(s);
   // Across a square's diagonal, a corner lies in the box of the triangle opposite it.
   EXPECT_FALSE(broad.distance_candidates(s.x, 0.005).empty());
-  EXPECT_FALSE(broad.any_within_reach(s.x, 0.005));
+  EXPECT_GT(broad.clearance(s.x, 0.005, 0.01), 0.005);
   // A vertex lies 0.05/√2 from the diagonal of its square that avoids it.
-  EXPECT_FALSE(broad.any_within_reach(s.x, 0.99 * 0.05 / std::sqrt(2.0)));
-  EXPECT_TRUE(broad.any_within_reach(s.x, 1.01 * 0.05 / std::sqrt(2.0)));
+  const double across = 0.05 / std::sqrt(2.0);
+  EXPECT_GT(broad.clearance(s.x, 0.99 * across, 2 * across), 0.99 * across);
+  EXPECT_LE(broad.clearance(s.x, 1.01 * across, 2 * across), 1.01 * across);
 }
 
 TEST(BroadPhase, RigidMotionFarFromContactNeedsNoCcd) {
@@ -410,7 +412,6 @@ TEST(BroadPhase, NonFinitePositionIsANumericalError) {
   bad(4, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW((void)broad.distance_candidates(bad, 0.01), NumericalError);
   EXPECT_THROW((void)broad.swept_candidates(s.x, bad, 0.01), NumericalError);
-  EXPECT_THROW((void)broad.any_within_reach(bad, 0.01), NumericalError);
   EXPECT_THROW((void)broad.clearance(bad, 0.01, 0.1), NumericalError);
   EXPECT_THROW((void)overlapping_triangle_boxes(bad, s.triangles), NumericalError);
 }
