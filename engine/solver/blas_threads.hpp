@@ -4,8 +4,9 @@
 // OpenBLAS (the BLAS that scripts/setup.sh installs) starts one busy-waiting thread per core.
 // On the 2-core machines PSQ runs on, every factorization then competes with whatever else
 // runs — the test suite's second job, a second sweep worker, a build — and spinning threads
-// lose more than they gain. Measured with bench_drape under such load (factorization ms per
-// Newton iteration, 2 threads → 1): 1.1k vertices 52–59 → 16–25, 5.3k 191–312 → 140–142,
+// lose more than they gain. Measured under such load (factorization ms per
+// Newton iteration, `bench_drape --sizes 1000,5000,20000 --frames 2`, run as is and with
+// OPENBLAS_NUM_THREADS=2; 2 threads → 1): 1.1k vertices 52–59 → 16–25, 5.3k 191–312 → 140–142,
 // 21k 1423–1627 → 1110–1354. On a quiet machine two threads gain little (same benchmark, 1 → 2
 // threads: 1.1k 19 → 26–29, 5.3k 122–130 → 112–119, 21k 601–606 → 542–558). So PSQ factorizes
 // single-threaded unless the user says otherwise (OPENBLAS_NUM_THREADS=2 for a lone run).
