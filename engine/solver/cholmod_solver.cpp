@@ -7,7 +7,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "engine/solver/blas_threads.hpp"
+#include "engine/solver/factorization_threads.hpp"
 
 namespace psq {
 namespace {
@@ -58,7 +58,7 @@ struct CholmodSolver::State {
   bool factorized = false;
 
   State() {
-    use_single_threaded_blas();
+    use_single_threaded_factorization();
     cholmod_start(&common);
     common.supernodal = CHOLMOD_SUPERNODAL;
     common.print = 0;  // the engine never prints; failures become exceptions

@@ -8,6 +8,7 @@
 //
 // Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
 //                          [--preview-tolerance T] [--scenes drape,twist,cylinder_compress]
+//                          [--preview-only 1]   (level 0 only, no direct solves)
 
 #include <fmt/format.h>
 
@@ -50,7 +51,8 @@ psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
   return scene;
 }
 
-void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings) {
+void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings,
+               bool preview_only) {
   auto start = Clock::now();
   psq::ProgressiveSimulation sim(scene, settings);
   const double hierarchy_seconds = seconds_since(start);
@@ -65,30 +67,35 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
   double preview_seconds = 0.0, total_seconds = 0.0;
   while (true) {
     start = Clock::now();
-    int steps = 0, iterations = 0;
+    int steps = 0, iterations = 0, shifted = 0, reanalyzed = 0;
     psq::PhaseTimes phases;
     while (!sim.level_done()) {
       const psq::ProgressiveStep step = sim.step();
       iterations += step.frame.newton.iterations;
       phases += step.frame.newton.times;
+      for (const psq::NewtonIteration& it : step.frame.newton.history) {
+        shifted += it.direction != psq::DirectionKind::newton;
+        reanalyzed += it.pattern_changed;
+      }
       ++steps;
     }
     const double level_seconds = seconds_since(start);
     total_seconds += level_seconds;
     std::cout << fmt::format(
         "  level {} ({} vertices): {} steps, {} iterations, {:.2f} s{} [assembly {:.2f}, "
-        "factorization {:.2f}, solve {:.2f}, line search {:.2f} s]\n",
+        "factorization {:.2f}, solve {:.2f}, line search {:.2f} s; {} shifted, {} re-analyzed]\n",
         sim.level(), sim.level_rest_mesh().vertex_count(), steps, iterations, level_seconds,
         sim.level_converged() ? "" : " (NOT converged)", phases.assembly, phases.factorization,
-        phases.solve, phases.line_search);
+        phases.solve, phases.line_search, shifted, reanalyzed);
     if (sim.level() == 0) {
       preview = sim.finest_positions();
       preview_seconds = level_seconds;
     }
-    if (sim.finished()) break;
+    if (sim.finished() || preview_only) break;
     sim.refine();
   }
 
+  if (preview_only) return;
   const psq::ShellSystem& fine = sim.finest_system();
   start = Clock::now();
   const psq::test::DirectRun direct = psq::test::settled_direct_run(fine, sim.finest_tolerance());
@@ -128,6 +135,7 @@ int main(int argc, char** argv) {
   std::string gradient = "exact";  // the solver's default (ProgressiveSettings)
   std::optional<double> preview_tolerance;  // unset: the scene's (default 10 × its tolerance)
   std::vector<std::string> scenes{"drape", "twist", "cylinder_compress"};
+  bool preview_only = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
     if (arg == "--vertices") vertices = std::stoi(value);
@@ -136,6 +144,7 @@ int main(int argc, char** argv) {
     else if (arg == "--gradient") gradient = value;
     else if (arg == "--preview-tolerance") preview_tolerance = std::stod(value);
     else if (arg == "--scenes") scenes = split(value);
+    else if (arg == "--preview-only") preview_only = value == "1";
     else {
       std::cerr << "unknown option " << arg << "\n";
       return 1;
@@ -150,7 +159,7 @@ int main(int argc, char** argv) {
     if (preview_tolerance) settings.schedule.preview_tolerance = preview_tolerance;
     settings.gradient =
         gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
-    run_scene(scene, settings);
+    run_scene(scene, settings, preview_only);
   }
   return 0;
 }
