@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/run_process.hpp"
+
 namespace psq::bench {
 namespace {
 
@@ -121,6 +123,38 @@ TEST(BenchOptions, BadNumbersAreRejectedWithOptionAndValue) {
 TEST(BenchOptions, BadDefaultIsTheProgramsMistake) {
   EXPECT_THROW(BenchOptions("bench_example", {{"frames", OptionType::count, "ten", "frames"}}),
                OptionError);
+}
+
+// The built benchmark: --help and a bad command line end before any benchmark work.
+TEST(BenchProgressive, HelpExitsZeroAndBadCommandLineExitsTwo) {
+  const test::ProcessResult help = test::run_process(PSQ_BENCH_PROGRESSIVE, {"--help"});
+  EXPECT_EQ(help.exit_code, 0) << help.errors;
+  EXPECT_NE(help.output.find("Usage: bench_progressive [options]"), std::string::npos)
+      << help.output;
+  EXPECT_NE(help.output.find("--preview-only"), std::string::npos) << help.output;
+  EXPECT_EQ(help.errors, "");
+
+  const test::ProcessResult missing = test::run_process(PSQ_BENCH_PROGRESSIVE, {"--vertices"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.output, "");
+  EXPECT_EQ(missing.errors.rfind("bench_progressive: option --vertices: missing value\nUsage:", 0),
+            0u)
+      << missing.errors;
+
+  const test::ProcessResult bad = test::run_process(PSQ_BENCH_PROGRESSIVE, {"--frames", "10x"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.errors.find("option --frames: expected a positive integer, got '10x'"),
+            std::string::npos)
+      << bad.errors;
+
+  // The program's own check of a value, made before any work, ends the same way.
+  const test::ProcessResult gradient =
+      test::run_process(PSQ_BENCH_PROGRESSIVE, {"--gradient", "exactly"});
+  EXPECT_EQ(gradient.exit_code, 2);
+  EXPECT_EQ(gradient.output, "");
+  EXPECT_NE(gradient.errors.find("option --gradient: expected exact or held, got 'exactly'"),
+            std::string::npos)
+      << gradient.errors;
 }
 
 }  // namespace
