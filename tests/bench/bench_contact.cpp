@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_options.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 
@@ -128,13 +129,9 @@ void print_skip_speedup(const Case& c, double scale, const std::string& when) {
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  double scale = 1.0;
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--scale" && i + 1 < argc) scale = std::stod(argv[++i]);
-
+/// Prints the phase split and the skips' speed-ups; the command line is read by run_benchmark.
+int bench_contact(const psq::bench::BenchOptions& options) {
+  const double scale = options.number("scale");
   fmt::print("time per Newton iteration [ms]\n");
   fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
              "vertices", "iters", "elastic+", "contact", "friction", "CCD", "factor", "wall",
@@ -148,4 +145,14 @@ int main(int argc, char** argv) {
       {{"twist_wrap", 0.1, 0.0, 14}, "self-contact from about frame 9"}};
   for (const auto& [c, when] : skip_cases) print_skip_speedup(c, scale, when);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using psq::bench::OptionType;
+  psq::bench::BenchOptions options(
+      "bench_contact", {{"scale", OptionType::positive_number, "1",
+                         "factor on every mesh edge length; 1: the sizes for about a minute"}});
+  return psq::bench::run_benchmark(options, argc, argv, bench_contact);
 }

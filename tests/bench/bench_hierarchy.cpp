@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_options.hpp"
 #include "engine/hierarchy/mesh_hierarchy.hpp"
 #include "engine/hierarchy/shell_prolongation.hpp"
 #include "engine/mesh/generators.hpp"
@@ -45,27 +46,25 @@ void report(const std::string& name, const psq::TriMesh& finest, int levels) {
   }
 }
 
+/// Reports the hierarchies of a sphere and of the bunny; the command line is read by
+/// run_benchmark.
+int bench_hierarchy(const psq::bench::BenchOptions& options) {
+  const int vertices = options.integer("vertices"), levels = options.integer("levels");
+  psq::SphereGenerator sphere;
+  // A geodesic sphere has about 4πr² / (√3/4 e²) / 2 vertices for edge length e.
+  sphere.edge_length =
+      std::sqrt(8 * M_PI * sphere.radius * sphere.radius / (std::sqrt(3.0) * vertices));
+  report("sphere", psq::make_sphere(sphere), levels);
+  report("bunny", psq::read_mesh(PSQ_SHARED_DIR "/data/meshes/bunny.obj"), levels);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int vertices = 40000, levels = 4;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string arg = argv[i];
-    if (arg == "--vertices")
-      vertices = std::stoi(argv[i + 1]);
-    else if (arg == "--levels")
-      levels = std::stoi(argv[i + 1]);
-  }
-  try {
-    psq::SphereGenerator sphere;
-    // A geodesic sphere has about 4πr² / (√3/4 e²) / 2 vertices for edge length e.
-    sphere.edge_length =
-        std::sqrt(8 * M_PI * sphere.radius * sphere.radius / (std::sqrt(3.0) * vertices));
-    report("sphere", psq::make_sphere(sphere), levels);
-    report("bunny", psq::read_mesh(PSQ_SHARED_DIR "/data/meshes/bunny.obj"), levels);
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "bench_hierarchy: {}\n", e.what());
-    return 1;
-  }
-  return 0;
+  using psq::bench::OptionType;
+  psq::bench::BenchOptions options(
+      "bench_hierarchy", {{"vertices", OptionType::count, "40000", "vertices of the sphere"},
+                          {"levels", OptionType::count, "4", "hierarchy levels"}});
+  return psq::bench::run_benchmark(options, argc, argv, bench_hierarchy);
 }

@@ -15,9 +15,8 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
-#include <optional>
-#include <sstream>
 
+#include "bench/bench_options.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "progressive/reference_runs.hpp"
@@ -27,13 +26,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
-  return out;
 }
 
 /// The library scene with its mesh's edge length set for about `vertices` vertices
@@ -128,38 +120,47 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       error(coarse_prolonged));
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  int vertices = 20000, levels = 3, frames = 10;
-  std::string gradient = "exact";  // the solver's default (ProgressiveSettings)
-  std::optional<double> preview_tolerance;  // unset: the scene's (default 10 × its tolerance)
-  std::vector<std::string> scenes{"drape", "twist", "cylinder_compress"};
-  bool preview_only = false;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string arg = argv[i], value = argv[i + 1];
-    if (arg == "--vertices") vertices = std::stoi(value);
-    else if (arg == "--levels") levels = std::stoi(value);
-    else if (arg == "--frames") frames = std::stoi(value);
-    else if (arg == "--gradient") gradient = value;
-    else if (arg == "--preview-tolerance") preview_tolerance = std::stod(value);
-    else if (arg == "--scenes") scenes = split(value);
-    else if (arg == "--preview-only") preview_only = value == "1";
-    else {
-      std::cerr << "unknown option " << arg << "\n";
-      return 1;
-    }
-  }
-  std::cout << fmt::format("bench_progressive: ~{} fine vertices, {} levels, {} frames, {} "
-                           "gradient\n", vertices, levels, frames, gradient);
+/// Runs every scene progressively and directly; the command line is read by run_benchmark.
+int bench_progressive(const psq::bench::BenchOptions& options) {
+  const int vertices = options.integer("vertices"), levels = options.integer("levels"),
+            frames = options.integer("frames");
+  const std::string gradient = options.text("gradient");
+  if (gradient != "exact" && gradient != "held")
+    psq::bench::reject_value("gradient", gradient, "exact or held");
+  const std::vector<std::string> scenes = options.texts("scenes");
+  const int preview_only = options.integer("preview-only");
+  if (preview_only != 0 && preview_only != 1)
+    psq::bench::reject_value("preview-only", std::to_string(preview_only), "0 or 1");
+  std::cout << fmt::format(
+      "bench_progressive: ~{} fine vertices, {} levels, {} frames, {} gradient\n", vertices, levels,
+      frames, gradient);
   for (const std::string& name : scenes) {
     const psq::Scene scene = sized_scene(name, vertices, frames);
     psq::ProgressiveSettings settings = psq::ProgressiveSettings::from_scene(scene);
     settings.schedule.levels = levels;
-    if (preview_tolerance) settings.schedule.preview_tolerance = preview_tolerance;
+    if (options.given("preview-tolerance"))
+      settings.schedule.preview_tolerance = options.number("preview-tolerance");
     settings.gradient =
         gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
-    run_scene(scene, settings, preview_only);
+    run_scene(scene, settings, preview_only == 1);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using psq::bench::OptionType;
+  psq::bench::BenchOptions options(
+      "bench_progressive",
+      {{"vertices", OptionType::count, "20000", "about this many fine vertices per scene"},
+       {"levels", OptionType::count, "3", "hierarchy levels"},
+       {"frames", OptionType::count, "10", "frames per scene"},
+       // The solver's default (ProgressiveSettings).
+       {"gradient", OptionType::text, "exact", "proxy gradient: exact or held"},
+       {"preview-tolerance", OptionType::positive_number, "",
+        "level-0 tolerance (default: the scene's, 10 x its tolerance)"},
+       {"scenes", OptionType::text_list, "drape,twist,cylinder_compress", "library scenes"},
+       {"preview-only", OptionType::integer, "0", "1: level 0 only, no direct solves"}});
+  return psq::bench::run_benchmark(options, argc, argv, bench_progressive);
 }

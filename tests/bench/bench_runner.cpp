@@ -2,7 +2,7 @@
 // against the time spent solving, for one job run through the executor exactly as `psq work`
 // runs it (heartbeat thread, in-level snapshots, level checkpoint, XDMF sidecar).
 //
-//   bench_runner [edge_length_m = 0.0014] [frames = 12] [snapshot_seconds = 60]
+//   bench_runner [--edge-length M] [--frames N] [--snapshot-seconds S]   (0.0014, 12, 60)
 //
 // A square plate clamped along one edge and loaded along the opposite one; the edge length sets
 // the mesh size (0.0014 m: ~21k vertices, over a minute on 2 cores). Target: store + checkpoint
@@ -12,9 +12,9 @@
 
 #include <atomic>
 #include <chrono>
-#include <cstdlib>
 #include <iostream>
 
+#include "bench/bench_options.hpp"
 #include "db/job_store.hpp"
 #include "jobs/direct_level_solver.hpp"
 #include "jobs/job_executor.hpp"
@@ -49,12 +49,15 @@ double get(const std::map<std::string, double>& timings, const std::string& phas
   return found == timings.end() ? 0.0 : found->second;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const double edge_length = argc > 1 ? std::atof(argv[1]) : 0.0014;
-  const int frames = argc > 2 ? std::atoi(argv[2]) : 12;
-  const double snapshot_seconds = argc > 3 ? std::atof(argv[3]) : 60.0;
+/// Runs the plate job and prints the overhead per level; the command line is read by
+/// run_benchmark.
+int bench_runner(const psq::bench::BenchOptions& options) {
+  const double edge_length = options.number("edge-length");
+  const int frames = options.integer("frames");
+  const double snapshot_seconds = options.number("snapshot-seconds");
+  if (snapshot_seconds < 0)
+    psq::bench::reject_value("snapshot-seconds", fmt::format("{}", snapshot_seconds),
+                             "a number >= 0");
   namespace fs = std::filesystem;
   using namespace psq;
 
@@ -100,4 +103,17 @@ int main(int argc, char** argv) {
   }
   std::cout << "(target: overhead below 2% for a job of over a minute)\n";
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using psq::bench::OptionType;
+  psq::bench::BenchOptions options(
+      "bench_runner", {{"edge-length", OptionType::positive_number, "0.0014",
+                        "plate mesh edge length [m]; 0.0014: ~21k vertices"},
+                       {"frames", OptionType::count, "12", "frames of the job"},
+                       {"snapshot-seconds", OptionType::number, "60",
+                        "wall time between in-level snapshots [s]; 0: at every chance"}});
+  return psq::bench::run_benchmark(options, argc, argv, bench_runner);
 }
