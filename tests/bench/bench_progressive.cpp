@@ -7,7 +7,8 @@
 // than the direct fine solve; progressive total faster than the direct fine solve.
 //
 // Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
-//                          [--preview-tolerance T] [--scenes drape,twist,cylinder_compress]
+//                          [--preview-tolerance T] [--preview-iterations K]
+//                          [--scenes drape,twist,cylinder_compress]
 //                          [--preview-only 1]   (level 0 only, no direct solves)
 
 #include <fmt/format.h>
@@ -140,6 +141,8 @@ int bench_progressive(const psq::bench::BenchOptions& options) {
     settings.schedule.levels = levels;
     if (options.given("preview-tolerance"))
       settings.schedule.preview_tolerance = options.number("preview-tolerance");
+    if (options.given("preview-iterations"))
+      settings.schedule.preview_iterations = options.integer("preview-iterations");
     settings.gradient =
         gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
     run_scene(scene, settings, preview_only == 1);
@@ -160,6 +163,8 @@ int main(int argc, char** argv) {
        {"gradient", OptionType::text, "exact", "proxy gradient: exact or held"},
        {"preview-tolerance", OptionType::positive_number, "",
         "level-0 tolerance (default: the scene's, 10 x its tolerance)"},
+       {"preview-iterations", OptionType::count, "",
+        "Newton-type iterations per preview step at most (default: the scene's, 8)"},
        {"scenes", OptionType::text_list, "drape,twist,cylinder_compress", "library scenes"},
        {"preview-only", OptionType::integer, "0", "1: level 0 only, no direct solves"}});
   return psq::bench::run_benchmark(options, argc, argv, bench_progressive);
