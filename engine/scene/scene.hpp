@@ -106,7 +106,7 @@ struct HierarchyOptions {
   /// Preview levels stop when a step changes the solution by less than this (‖Δx‖∞/Δt)
   /// [m/s]. Unset: 10 × the solver tolerance.
   std::optional<double> preview_tolerance;
-  int preview_iterations = 8;       ///< Newton-type iterations per preview step at most
+  int preview_iterations = 2;       ///< Newton-type iterations per preview step at most
   std::optional<int> refine_frame;  ///< the frame where levels are refined; unset: the last
 };
 

@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
        {"preview-tolerance", OptionType::positive_number, "",
         "level-0 tolerance (default: the scene's, 10 x its tolerance)"},
        {"preview-iterations", OptionType::count, "",
-        "Newton-type iterations per preview step at most (default: the scene's, 8)"},
+        "Newton-type iterations per preview step at most (default: the scene's, 2)"},
        {"scenes", OptionType::text_list, "drape,twist,cylinder_compress", "library scenes"},
        {"preview-only", OptionType::integer, "0", "1: level 0 only, no direct solves"}});
   return psq::bench::run_benchmark(options, argc, argv, bench_progressive);

@@ -696,7 +696,7 @@ TEST(ReadScene, ReadsTheHierarchyTableAndItsDefaults) {
   EXPECT_EQ(plain.hierarchy.levels, 1);
   EXPECT_EQ(plain.hierarchy.vertex_ratio, 0.25);
   EXPECT_FALSE(plain.hierarchy.preview_tolerance.has_value());
-  EXPECT_EQ(plain.hierarchy.preview_iterations, 8);
+  EXPECT_EQ(plain.hierarchy.preview_iterations, 2);
   EXPECT_FALSE(plain.hierarchy.refine_frame.has_value());
 
   const Scene scene =
