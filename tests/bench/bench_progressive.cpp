@@ -1,10 +1,13 @@
 // Benchmark (prints, never fails on a slow machine): progressive vs direct simulation of the
 // drape, twist and cylinder scenes at ~20k–50k fine vertices. Per scene: the time of the direct
-// fine solve, of each progressive level and in total, and the errors (max vertex distance /
-// bounding-box diagonal) to the settled direct fine answer of: the progressive finest answer,
-// the level-0 preview prolonged to the finest mesh, and a direct simulation of the level-0 mesh
-// (its own elastics) prolonged the same way. Targets (issue 4): level-0 preview ≥ 50× faster
-// than the direct fine solve; progressive total faster than the direct fine solve.
+// fine solve, of each progressive level and in total, and the errors (max and rms vertex
+// distance / bounding-box diagonal) to the settled direct fine answer of: the progressive finest
+// answer, the level-0 preview prolonged to the finest mesh, a direct simulation of the level-0
+// mesh (its own elastics) prolonged the same way, and the direct fine answer itself sampled at
+// the level-0 vertices and prolonged (about the best the level-0 space can hold); and, without
+// the prolongation, the preview's and the direct coarse answer's distances at the level-0
+// vertices to that sample. Targets (issue 4): level-0 preview ≥ 50× faster than the direct fine
+// solve; progressive total faster than the direct fine solve.
 //
 // Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
 //                          [--preview-tolerance T] [--preview-iterations K]
@@ -13,6 +16,12 @@
 
 #include <fmt/format.h>
 
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <Eigen/QR>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -44,6 +53,45 @@ psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
   return scene;
 }
 
+/// `deformed` (positions of `rest`'s vertices) at the points of `rest` closest to each of
+/// `points` (barycentric interpolation in the closest triangle), and how far the farthest of
+/// `points` lies from `rest`.
+struct Sample {
+  psq::Positions values;
+  double largest_distance = 0.0;
+};
+Sample sample_at(const psq::TriMesh& rest, const psq::Positions& deformed,
+                 const psq::Positions& points) {
+  using Kernel = CGAL::Simple_cartesian<double>;
+  using Triangles = std::vector<Kernel::Triangle_3>;
+  using Primitive = CGAL::AABB_triangle_primitive<Kernel, Triangles::const_iterator>;
+  const auto point = [](const auto& row) { return Kernel::Point_3(row(0), row(1), row(2)); };
+  Triangles triangles;
+  for (int t = 0; t < rest.triangle_count(); ++t)
+    triangles.emplace_back(point(rest.vertices.row(rest.triangles(t, 0))),
+                           point(rest.vertices.row(rest.triangles(t, 1))),
+                           point(rest.vertices.row(rest.triangles(t, 2))));
+  const CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>> tree(triangles.begin(),
+                                                                    triangles.end());
+  Sample result{psq::Positions(points.rows(), 3)};
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const auto [closest, triangle] = tree.closest_point_and_primitive(point(points.row(i)));
+    result.largest_distance = std::max(
+        result.largest_distance, std::sqrt(CGAL::squared_distance(closest, point(points.row(i)))));
+    const auto corners = rest.triangles.row(triangle - triangles.begin());
+    // Barycentric coordinates of the closest point: least squares in the triangle's plane.
+    const Eigen::Vector3d a = rest.vertices.row(corners(0)).transpose();
+    Eigen::Matrix<double, 3, 2> edges;
+    edges << rest.vertices.row(corners(1)).transpose() - a,
+        rest.vertices.row(corners(2)).transpose() - a;
+    const Eigen::Vector2d uv = edges.colPivHouseholderQr().solve(
+        Eigen::Vector3d(closest.x(), closest.y(), closest.z()) - a);
+    result.values.row(i) = (1 - uv.sum()) * deformed.row(corners(0)) +
+                           uv(0) * deformed.row(corners(1)) + uv(1) * deformed.row(corners(2));
+  }
+  return result;
+}
+
 void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings,
                bool preview_only) {
   auto start = Clock::now();
@@ -56,7 +104,7 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
     for (const psq::HierarchyLevel& level : h.levels) std::cout << " " << level.rest.vertex_count();
   std::cout << "\n";
 
-  Eigen::VectorXd preview;
+  Eigen::VectorXd preview, preview_level0;
   double preview_seconds = 0.0, total_seconds = 0.0;
   while (true) {
     start = Clock::now();
@@ -82,6 +130,7 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
         phases.solve, phases.line_search, shifted, reanalyzed);
     if (sim.level() == 0) {
       preview = sim.finest_positions();
+      preview_level0 = sim.positions();
       preview_seconds = level_seconds;
     }
     if (sim.finished() || preview_only) break;
@@ -105,20 +154,41 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
   const Eigen::VectorXd coarse_prolonged =
       psq::flat(to_finest.apply(psq::as_positions(direct_coarse.positions)));
 
-  const double diagonal = psq::bounding_box_diagonal(fine.rest_mesh().vertices);
-  const auto error = [&](const Eigen::VectorXd& x) {
-    return psq::test::max_vertex_distance(x, direct.positions) / diagonal;
+  // What the level-0 space can hold at best, roughly: the direct fine answer sampled at the
+  // level-0 rest vertices (each at its closest point on the fine rest mesh), prolonged by P^0.
+  const psq::Positions& fine_rest = fine.rest_mesh().vertices;
+  const Sample sample = sample_at(fine.rest_mesh(), psq::as_positions(direct.positions),
+                                  h.levels[0].rest.vertices);
+  const psq::Positions& sampled = sample.values;
+  const Eigen::VectorXd sampled_prolonged = psq::flat(to_finest.apply(sampled));
+
+  const double diagonal = psq::bounding_box_diagonal(fine_rest);
+  const auto errors = [&](const Eigen::VectorXd& x) {
+    return fmt::format("{:.2e} ({:.2e})",
+                       psq::test::max_vertex_distance(x, direct.positions) / diagonal,
+                       psq::test::rms_vertex_distance(x, direct.positions) / diagonal);
+  };
+  // The same distances without the prolongation's interpolation error: at the level-0 vertices,
+  // to the sampled fine answer.
+  const auto errors_at_level0 = [&](const Eigen::VectorXd& x) {
+    return fmt::format("{:.2e} ({:.2e})",
+                       psq::test::max_vertex_distance(x, psq::flat(sampled)) / diagonal,
+                       psq::test::rms_vertex_distance(x, psq::flat(sampled)) / diagonal);
   };
   std::cout << fmt::format(
       "  direct fine: {} iterations, {:.2f} s{}; direct coarse: {:.2f} s\n"
       "  progressive: preview {:.2f} s ({:.1f}× faster than direct fine), total {:.2f} s "
       "({:.2f}× the direct fine time)\n"
-      "  error / bbox diagonal: progressive finest {:.2e}, level-0 preview {:.2e}, "
-      "direct coarse {:.2e}\n",
+      "  error / bbox diagonal, max (rms): progressive finest {}, level-0 preview {}, "
+      "direct coarse {}, fine answer sampled at level 0 {}\n"
+      "  at the level-0 vertices, max (rms): level-0 preview {}, direct coarse {} (the level-0 "
+      "rest vertices lie up to {:.1e} off the fine rest mesh: the samples are exact only at 0)\n",
       direct.newton_iterations, direct_seconds, direct.settled ? "" : " (NOT settled)",
       coarse_seconds, preview_seconds, direct_seconds / preview_seconds, total_seconds,
-      total_seconds / direct_seconds, error(sim.positions()), error(preview),
-      error(coarse_prolonged));
+      total_seconds / direct_seconds, errors(sim.positions()), errors(preview),
+      errors(coarse_prolonged), errors(sampled_prolonged),
+      errors_at_level0(preview_level0), errors_at_level0(direct_coarse.positions),
+      sample.largest_distance / diagonal);
 }
 
 /// Runs every scene progressively and directly; the command line is read by run_benchmark.

@@ -50,4 +50,9 @@ inline double max_vertex_distance(const Eigen::VectorXd& a, const Eigen::VectorX
   return worst;
 }
 
+/// The root mean square of the per-vertex distances between flat positions a and b.
+inline double rms_vertex_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return std::sqrt((a - b).squaredNorm() / double(a.size() / 3));
+}
+
 }  // namespace psq::test
