@@ -23,6 +23,12 @@ struct NewtonSettings {
   double armijo = 1e-4;       ///< c in E(x + αd) ≤ E(x) + c·α·gᵀd
   double backtracking = 0.5;  ///< α ← backtracking·α after a rejected trial
   double min_step = 1e-12;    ///< the line search fails once α drops below this (≈ 40 halvings)
+  /// false: after the max_iterations-th step the solve ends without evaluating the final
+  /// iterate (no gradient, Hessian or factorization there), so it reports converged = false
+  /// without knowing. For steps capped by design whose convergence nobody asks (progressive
+  /// previews: settling decides when a level is done); it saves a third of their work at a cap
+  /// of 2.
+  bool judge_final_iterate = true;
 };
 
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected

@@ -53,10 +53,12 @@ struct NewtonIteration {
 /// taken without meeting the tolerance; the caller decides what that means.
 struct NewtonResult {
   bool converged = false;
-  int iterations = 0;          ///< steps taken (history.size() − 1)
+  /// Steps taken: history.size() − 1, or history.size() when the final iterate was not judged
+  /// (NewtonSettings::judge_final_iterate): then the last record is the last step's.
+  int iterations = 0;
   double energy = 0.0;         ///< final E(x)
-  double gradient_norm = 0.0;  ///< final ‖∇E(x)‖₂ over the free DOFs
-  double step_norm = 0.0;      ///< final ‖d‖∞ / step_scale
+  double gradient_norm = 0.0;  ///< ‖∇E‖₂ over the free DOFs at the last judged iterate
+  double step_norm = 0.0;      ///< ‖d‖∞ / step_scale at the last judged iterate
   PhaseTimes times;            ///< sum of the per-iteration times
   double wall_seconds = 0.0;   ///< the whole call, ≥ times.total()
   std::vector<NewtonIteration> history;

@@ -455,6 +455,38 @@ TEST(Newton, ExtendsFullStepsWhereHessianOverestimatesCurvature) {
   EXPECT_LE(result.iterations, 20);
 }
 
+// A solve capped by design skips the final iterate: two steps cost two gradients and two
+// factorizations instead of three, end at the same point, and report not converged.
+TEST(Newton, CappedSolveWithoutFinalJudgementSkipsTheLastEvaluation) {
+  NewtonSettings settings = tight_settings();
+  settings.max_iterations = 2;
+  const DofMap dofs(1, {});
+  const auto run = [&](bool judge, ProbeQuadratic& probe, Eigen::VectorXd& x) {
+    settings.judge_final_iterate = judge;
+    NewtonSolver solver;
+    return solver.minimize(probe, x, dofs, settings);
+  };
+  ProbeQuadratic judged_probe(3, -2.0), capped_probe(3, -2.0);
+  // d = −g/1.5: each full step removes 2/3 of the error (E drops by 2/3 of the linear
+  // prediction, too little to extend the step), so two steps stop short.
+  judged_probe.hessian_diagonal = capped_probe.hessian_diagonal = 1.5;
+  Eigen::VectorXd judged_x = Eigen::VectorXd::Zero(3), capped_x = judged_x;
+  const NewtonResult judged = run(true, judged_probe, judged_x);
+  const NewtonResult capped = run(false, capped_probe, capped_x);
+
+  EXPECT_FALSE(judged.converged);
+  EXPECT_FALSE(capped.converged);
+  EXPECT_EQ(judged.iterations, 2);
+  EXPECT_EQ(capped.iterations, 2);
+  EXPECT_EQ(judged_probe.iterates.size(), 3u);  // gradients evaluated
+  EXPECT_EQ(capped_probe.iterates.size(), 2u);
+  ASSERT_EQ(capped.history.size(), 2u);
+  EXPECT_GT(capped.history.back().step_length, 0.0);
+  EXPECT_TRUE(capped_x == judged_x);
+  EXPECT_DOUBLE_EQ(capped.energy, judged.energy);
+  EXPECT_DOUBLE_EQ(capped.energy, capped_probe.value(capped_x));
+}
+
 // The extension asks the CCD about the whole longer motion: it stops at the last α whose
 // displacement the feasible-step bound allows.
 TEST(Newton, ExtensionRespectsMaxFeasibleStep) {
