@@ -23,7 +23,7 @@ HingeRest hinge_rest(const HingePositions& rest) {
 }
 
 double hinge_angle_deviation(const HingePositions& x, const HingeRest& rest) {
-  return std::remainder(dihedral_angle(x) - rest.angle, 2.0 * std::numbers::pi);
+  return angle_difference(dihedral_angle(x), rest.angle);
 }
 
 double hinge_energy(const HingePositions& x, const HingeRest& rest, double stiffness) {

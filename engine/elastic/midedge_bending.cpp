@@ -203,8 +203,7 @@ Eigen::Vector3d midedge_angle_change(const MidedgePositions& x, const MidedgeRes
   Eigen::Vector3d change = Eigen::Vector3d::Zero();
   for (int i = 0; i < 3; ++i)
     if (rest.interior[i])
-      change[i] = std::remainder(dihedral_angle(midedge_hinge(x, i)) - rest.angle[i],
-                                 2.0 * std::numbers::pi);
+      change[i] = angle_difference(dihedral_angle(midedge_hinge(x, i)), rest.angle[i]);
   return change;
 }
 

@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "elastic/elastic_test_meshes.hpp"
 #include "engine/core/error.hpp"
@@ -97,6 +101,30 @@ TEST(DihedralAngle, DegenerateHingeHasNoDerivatives) {
   EXPECT_EQ(dihedral_angle(x), 0.0);
   EXPECT_THROW(dihedral_angle_gradient(x), NumericalError);
   EXPECT_THROW(dihedral_angle_relative_hessian(x), NumericalError);
+}
+
+}  // namespace
+}  // namespace psq
+
+namespace psq {
+namespace {
+
+// angle_difference has the value of std::remainder(θ − θ̄, 2π) for angles in [−π, π] (== also
+// equates −0 and +0, which it returns for θ − θ̄ = −2π): at the wrap points ±π, just past them,
+// and on random pairs.
+TEST(AngleDifference, EqualsTheRemainderOfTheDifference) {
+  const double pi = std::numbers::pi;
+  std::vector<std::pair<double, double>> pairs{
+      {pi, 0.0},  {-pi, 0.0}, {pi, -pi},  {-pi, pi},  {0.0, pi},  {0.0, -pi},
+      {3.0, -3.0}, {-3.0, 3.0}, {pi, -1e-300}, {std::nextafter(pi, 0.0), -pi}, {1e-17, -1e-17}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-pi, pi);
+  for (int i = 0; i < 100000; ++i) pairs.emplace_back(angle(rng), angle(rng));
+  for (const auto& [theta, rest] : pairs) {
+    const double expected = std::remainder(theta - rest, 2.0 * pi);
+    const double actual = angle_difference(theta, rest);
+    ASSERT_EQ(expected, actual) << "θ = " << theta << ", θ̄ = " << rest << ": " << expected << " vs " << actual;
+  }
 }
 
 }  // namespace
