@@ -101,7 +101,6 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
 
   Eigen::VectorXd gradient;
   Eigen::VectorXd free_gradient;
-  bool final_iterate_judged = true;
   for (int k = 0;; ++k) {
     record.iteration = k;
     record.energy = energy;
@@ -128,16 +127,14 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     result.times += record.times;
     if (progress) progress(record);
     if (result.converged || k == settings.max_iterations) break;
-    if (k + 1 == settings.max_iterations && !settings.judge_final_iterate) {
-      final_iterate_judged = false;
-      break;
-    }
+    if (k + 1 == settings.max_iterations && !settings.judge_final_iterate) break;
     record = NewtonIteration{};
   }
 
+  // A judged final iterate is a record without a step; an unjudged solve ends on a step.
   const NewtonIteration& last = result.history.back();
-  result.iterations = final_iterate_judged ? last.iteration : last.iteration + 1;
-  result.energy = final_iterate_judged ? last.energy : energy;
+  result.iterations = last.step_length > 0.0 ? last.iteration + 1 : last.iteration;
+  result.energy = energy;
   result.gradient_norm = last.gradient_norm;
   result.step_norm = last.step_norm;
   result.wall_seconds =

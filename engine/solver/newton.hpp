@@ -26,8 +26,8 @@ struct NewtonSettings {
   /// false: after the max_iterations-th step the solve ends without evaluating the final
   /// iterate (no gradient, Hessian or factorization there), so it reports converged = false
   /// without knowing. For steps capped by design whose convergence nobody asks (progressive
-  /// previews: settling decides when a level is done); it saves a third of their work at a cap
-  /// of 2.
+  /// previews: settling decides when a level is done): at a cap of 2 it saves one of a step's
+  /// three gradient–Hessian–factorization rounds (Newton.CappedSolve… counts the gradients).
   bool judge_final_iterate = true;
 };
 

@@ -33,7 +33,8 @@ enum class DirectionKind {
 };
 
 /// One Newton iteration. The last record of a solve is the convergence check: it carries the
-/// final energy, gradient norm and step norm, and takes no step (step_length = 0).
+/// final energy, gradient norm and step norm, and takes no step (step_length = 0) — unless the
+/// final iterate was not judged (NewtonSettings::judge_final_iterate), when it is the last step.
 struct NewtonIteration {
   int iteration = 0;
   double energy = 0.0;         ///< E(x) at the start of the iteration
