@@ -5,7 +5,6 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
 #include "engine/core/error.hpp"
 #include "engine/elastic/element_loop.hpp"

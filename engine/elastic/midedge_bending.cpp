@@ -7,7 +7,6 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
 #include "engine/core/error.hpp"
 #include "engine/elastic/element_loop.hpp"
