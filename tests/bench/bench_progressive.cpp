@@ -21,12 +21,12 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
 
-#include <Eigen/QR>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 
 #include "bench/bench_options.hpp"
+#include "engine/contact/point_triangle_distance.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "progressive/reference_runs.hpp"
@@ -79,15 +79,18 @@ Sample sample_at(const psq::TriMesh& rest, const psq::Positions& deformed,
     result.largest_distance = std::max(
         result.largest_distance, std::sqrt(CGAL::squared_distance(closest, point(points.row(i)))));
     const auto corners = rest.triangles.row(triangle - triangles.begin());
-    // Barycentric coordinates of the closest point: least squares in the triangle's plane.
-    const Eigen::Vector3d a = rest.vertices.row(corners(0)).transpose();
-    Eigen::Matrix<double, 3, 2> edges;
-    edges << rest.vertices.row(corners(1)).transpose() - a,
-        rest.vertices.row(corners(2)).transpose() - a;
-    const Eigen::Vector2d uv = edges.colPivHouseholderQr().solve(
-        Eigen::Vector3d(closest.x(), closest.y(), closest.z()) - a);
-    result.values.row(i) = (1 - uv.sum()) * deformed.row(corners(0)) +
-                           uv(0) * deformed.row(corners(1)) + uv(1) * deformed.row(corners(2));
+    const auto vertex = [&](int k) -> Eigen::Vector3d {
+      return rest.vertices.row(corners(k)).transpose();
+    };
+    // The closest point lies on the triangle, so it is its own foot on the triangle's plane,
+    // whose barycentric coordinates are minus the weights of t0, t1, t2.
+    const Eigen::Vector3d barycentric =
+        -psq::point_plane_closest_pair(Eigen::Vector3d(closest.x(), closest.y(), closest.z()),
+                                       vertex(0), vertex(1), vertex(2))
+             .weights.tail<3>();
+    result.values.row(i) = barycentric(0) * deformed.row(corners(0)) +
+                           barycentric(1) * deformed.row(corners(1)) +
+                           barycentric(2) * deformed.row(corners(2));
   }
   return result;
 }
@@ -156,24 +159,16 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
 
   // What the level-0 space can hold at best, roughly: the direct fine answer sampled at the
   // level-0 rest vertices (each at its closest point on the fine rest mesh), prolonged by P^0.
-  const psq::Positions& fine_rest = fine.rest_mesh().vertices;
   const Sample sample = sample_at(fine.rest_mesh(), psq::as_positions(direct.positions),
                                   h.levels[0].rest.vertices);
-  const psq::Positions& sampled = sample.values;
-  const Eigen::VectorXd sampled_prolonged = psq::flat(to_finest.apply(sampled));
+  const Eigen::VectorXd sampled = psq::flat(sample.values);
+  const Eigen::VectorXd sampled_prolonged = psq::flat(to_finest.apply(sample.values));
 
-  const double diagonal = psq::bounding_box_diagonal(fine_rest);
-  const auto errors = [&](const Eigen::VectorXd& x) {
+  const double diagonal = psq::bounding_box_diagonal(fine.rest_mesh().vertices);
+  const auto errors = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& reference) {
     return fmt::format("{:.2e} ({:.2e})",
-                       psq::test::max_vertex_distance(x, direct.positions) / diagonal,
-                       psq::test::rms_vertex_distance(x, direct.positions) / diagonal);
-  };
-  // The same distances without the prolongation's interpolation error: at the level-0 vertices,
-  // to the sampled fine answer.
-  const auto errors_at_level0 = [&](const Eigen::VectorXd& x) {
-    return fmt::format("{:.2e} ({:.2e})",
-                       psq::test::max_vertex_distance(x, psq::flat(sampled)) / diagonal,
-                       psq::test::rms_vertex_distance(x, psq::flat(sampled)) / diagonal);
+                       psq::test::max_vertex_distance(x, reference) / diagonal,
+                       psq::test::rms_vertex_distance(x, reference) / diagonal);
   };
   std::cout << fmt::format(
       "  direct fine: {} iterations, {:.2f} s{}; direct coarse: {:.2f} s\n"
@@ -185,9 +180,11 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       "rest vertices lie up to {:.1e} off the fine rest mesh: the samples are exact only at 0)\n",
       direct.newton_iterations, direct_seconds, direct.settled ? "" : " (NOT settled)",
       coarse_seconds, preview_seconds, direct_seconds / preview_seconds, total_seconds,
-      total_seconds / direct_seconds, errors(sim.positions()), errors(preview),
-      errors(coarse_prolonged), errors(sampled_prolonged),
-      errors_at_level0(preview_level0), errors_at_level0(direct_coarse.positions),
+      total_seconds / direct_seconds, errors(sim.positions(), direct.positions),
+      errors(preview, direct.positions), errors(coarse_prolonged, direct.positions),
+      errors(sampled_prolonged, direct.positions),
+      // Without the prolongation's interpolation error: at the level-0 vertices, to the sample.
+      errors(preview_level0, sampled), errors(direct_coarse.positions, sampled),
       sample.largest_distance / diagonal);
 }
 
