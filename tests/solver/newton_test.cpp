@@ -195,6 +195,18 @@ NewtonSettings tight_settings() {
   return settings;
 }
 
+/// A probe minimized from x = 0 with every DOF free: where it ended and how.
+struct ProbeRun {
+  Eigen::VectorXd x;
+  NewtonResult result;
+};
+ProbeRun run_from_origin(ProbeQuadratic& probe, const NewtonSettings& settings) {
+  ProbeRun run{Eigen::VectorXd::Zero(probe.size()), {}};
+  NewtonSolver solver;
+  run.result = solver.minimize(probe, run.x, DofMap(probe.size() / 3, {}), settings);
+  return run;
+}
+
 TEST(Newton, QuadraticConvergesInOneStep) {
   const int vertices = 6;
   std::mt19937 rng(12);
@@ -409,10 +421,7 @@ TEST(Newton, NonFiniteStartIsNamed) {
 TEST(Newton, NanAwayFromIterateForcesBacktracking) {
   ProbeQuadratic probe(6, 3.0);
   probe.nan_radius = 0.6;
-  const DofMap dofs(2, {});
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
-  NewtonSolver solver;
-  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  const auto [x, result] = run_from_origin(probe, tight_settings());
   ASSERT_TRUE(result.converged);
   EXPECT_LT((x.array() - 3.0).abs().maxCoeff(), 1e-12);
   EXPECT_LT(result.history[0].step_length, 1.0);
@@ -425,10 +434,7 @@ TEST(Newton, NanAwayFromIterateForcesBacktracking) {
 TEST(Newton, RespectsMaxFeasibleStep) {
   ProbeQuadratic probe(3, -2.0);
   probe.max_displacement = 0.25;
-  const DofMap dofs(1, {});
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
-  NewtonSolver solver;
-  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  const auto [x, result] = run_from_origin(probe, tight_settings());
   ASSERT_TRUE(result.converged);
   EXPECT_LT((x.array() + 2.0).abs().maxCoeff(), 1e-12);
   EXPECT_GE(result.iterations, 8);  // 2 / 0.25 steps at least
@@ -443,10 +449,7 @@ TEST(Newton, RespectsMaxFeasibleStep) {
 TEST(Newton, ExtendsFullStepsWhereHessianOverestimatesCurvature) {
   ProbeQuadratic probe(3, -2.0);
   probe.hessian_diagonal = 100.0;
-  const DofMap dofs(1, {});
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
-  NewtonSolver solver;
-  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  const auto [x, result] = run_from_origin(probe, tight_settings());
   ASSERT_TRUE(result.converged);
   // The tolerance bounds d = −g/100, so the error is within 100 × 1e-10.
   EXPECT_LT((x.array() + 2.0).abs().maxCoeff(), 1e-8);
@@ -460,19 +463,13 @@ TEST(Newton, ExtendsFullStepsWhereHessianOverestimatesCurvature) {
 TEST(Newton, CappedSolveWithoutFinalJudgementSkipsTheLastEvaluation) {
   NewtonSettings settings = tight_settings();
   settings.max_iterations = 2;
-  const DofMap dofs(1, {});
-  const auto run = [&](bool judge, ProbeQuadratic& probe, Eigen::VectorXd& x) {
-    settings.judge_final_iterate = judge;
-    NewtonSolver solver;
-    return solver.minimize(probe, x, dofs, settings);
-  };
   ProbeQuadratic judged_probe(3, -2.0), capped_probe(3, -2.0);
   // d = −g/1.5: each full step removes 2/3 of the error (E drops by 2/3 of the linear
   // prediction, too little to extend the step), so two steps stop short.
   judged_probe.hessian_diagonal = capped_probe.hessian_diagonal = 1.5;
-  Eigen::VectorXd judged_x = Eigen::VectorXd::Zero(3), capped_x = judged_x;
-  const NewtonResult judged = run(true, judged_probe, judged_x);
-  const NewtonResult capped = run(false, capped_probe, capped_x);
+  const auto [judged_x, judged] = run_from_origin(judged_probe, settings);
+  settings.judge_final_iterate = false;
+  const auto [capped_x, capped] = run_from_origin(capped_probe, settings);
 
   EXPECT_FALSE(judged.converged);
   EXPECT_FALSE(capped.converged);
@@ -493,10 +490,7 @@ TEST(Newton, ExtensionRespectsMaxFeasibleStep) {
   ProbeQuadratic probe(3, -2.0);
   probe.hessian_diagonal = 100.0;
   probe.max_displacement = 0.1;  // d = −0.02 per coordinate: α = 4 moves 0.08, α = 8 0.16
-  const DofMap dofs(1, {});
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
-  NewtonSolver solver;
-  const NewtonResult result = solver.minimize(probe, x, dofs, tight_settings());
+  const auto [x, result] = run_from_origin(probe, tight_settings());
   EXPECT_EQ(result.history[0].step_length, 4.0);
   for (std::size_t k = 1; k < probe.iterates.size(); ++k)
     EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.1 + 1e-15);
