@@ -3,12 +3,17 @@
 //   F(x_l) = 1/(2Δt²)‖x_l − x_lᵗ‖²_{M_l} + Ψ_L(P^l(x_l)) − f_L·P^l(x_l),
 // fine-scale elastics Ψ_L and external force f_L evaluated through the direct prolongation P^l,
 // level-l masses M_l. Newton-type steps use level l's own projected Hessian as preconditioner,
-//   H(x_l) = M_l/Δt² + PSD(∇²E_l(x_l)),
+//   H(x_l) = M_l/Δt² + PSD(∇²E_membrane,l(x_l)) + s_l·PSD(∇²E_bending,l(x_l)),
+// with the bending part scaled by s_l, about how much stiffer the fine bending through P^l is
+// (√(fine / level triangles), the coarse/fine edge-length ratio): without it the steps
+// overshoot and the line search backtracks.
 // and either the exact gradient or the paper's eq.-10 gradient with the offsets held.
 
 #include "engine/progressive/level_objective.hpp"
 #include "engine/progressive/system_prolongation.hpp"
 #include "engine/sim/shell_system.hpp"
+
+#include <vector>
 
 namespace psq {
 
@@ -51,6 +56,7 @@ class ProxyObjective : public LevelObjective {
   const ShellSystem& finest_;
   const SystemProlongation& to_finest_;
   double inertia_weight_;  ///< 1/Δt²
+  std::vector<double> bending_scale_;  ///< s_l per shell
   ProxyGradient gradient_kind_;
   Eigen::VectorXd previous_;
   // The memo of prolonged(); mutable so that the const elastic_energy() shares it.
