@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "engine/core/error.hpp"
 #include "engine/elastic/element_loop.hpp"
@@ -26,14 +27,15 @@ double hinge_angle_deviation(const HingePositions& x, const HingeRest& rest) {
 }
 
 double hinge_energy(const HingePositions& x, const HingeRest& rest, double stiffness) {
-  if (is_degenerate_hinge(x)) return std::numeric_limits<double>::infinity();
-  const double deviation = hinge_angle_deviation(x, rest);
+  const std::optional<double> theta = regular_dihedral_angle(x);
+  if (!theta) return std::numeric_limits<double>::infinity();
+  const double deviation = angle_difference(*theta, rest.angle);
   return stiffness * rest.weight * deviation * deviation;
 }
 
 HingeVector hinge_gradient(const HingePositions& x, const HingeRest& rest, double stiffness) {
-  return 2.0 * stiffness * rest.weight * hinge_angle_deviation(x, rest) *
-         dihedral_angle_gradient(x);
+  const auto [theta, gradient] = dihedral_angle_and_gradient(x);
+  return 2.0 * stiffness * rest.weight * angle_difference(theta, rest.angle) * gradient;
 }
 
 HingeMatrix hinge_hessian(const HingePositions& x, const HingeRest& rest, double stiffness,

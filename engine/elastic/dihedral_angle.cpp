@@ -72,24 +72,37 @@ RelativeGradient relative_gradient(const HingeFrame& f) {
   return r;
 }
 
-}  // namespace
-
-double dihedral_angle(const HingePositions& x) {
-  const HingeFrame f = hinge_frame(x);
+double angle(const HingeFrame& f) {
   // Both atan2 arguments carry the factor |n0||n1||e|, so no normalization is needed and a
   // degenerate hinge gives atan2(0, 0) = 0 instead of NaN.
   return std::atan2(f.e.dot(f.n0.cross(f.n1)), f.e_norm * f.n0.dot(f.n1));
 }
 
-bool is_degenerate_hinge(const HingePositions& x) { return is_degenerate(hinge_frame(x)); }
-
-HingeVector dihedral_angle_gradient(const HingePositions& x) {
-  const HingeFrame f = hinge_frame(x);
+HingeVector gradient(const HingeFrame& f) {
   require_regular(f);
   const RelativeGradient r = relative_gradient(f);
   HingeVector g;
   g << -(r.g1 + r.g2 + r.g3), r.g1, r.g2, r.g3;
   return g;
+}
+
+}  // namespace
+
+double dihedral_angle(const HingePositions& x) { return angle(hinge_frame(x)); }
+
+std::optional<double> regular_dihedral_angle(const HingePositions& x) {
+  const HingeFrame f = hinge_frame(x);
+  if (is_degenerate(f)) return std::nullopt;
+  return angle(f);
+}
+
+bool is_degenerate_hinge(const HingePositions& x) { return is_degenerate(hinge_frame(x)); }
+
+HingeVector dihedral_angle_gradient(const HingePositions& x) { return gradient(hinge_frame(x)); }
+
+DihedralAngleAndGradient dihedral_angle_and_gradient(const HingePositions& x) {
+  const HingeFrame f = hinge_frame(x);
+  return {angle(f), gradient(f)};
 }
 
 HingeRelativeMatrix dihedral_angle_relative_hessian(const HingePositions& x) {

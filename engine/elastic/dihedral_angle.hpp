@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <numbers>
+#include <optional>
 
 namespace psq {
 
@@ -45,6 +46,18 @@ bool is_degenerate_hinge(const HingePositions& x);
 ///   ∂θ/∂x1 = −α0 ∂θ/∂x2 − α1 ∂θ/∂x3,  ∂θ/∂x0 = −(∂θ/∂x1 + ∂θ/∂x2 + ∂θ/∂x3).
 /// Throws NumericalError for a degenerate hinge (is_degenerate_hinge).
 HingeVector dihedral_angle_gradient(const HingePositions& x);
+
+/// θ and ∇θ from one evaluation of the hinge's edge and normals (a bending gradient needs both).
+/// Throws NumericalError for a degenerate hinge.
+struct DihedralAngleAndGradient {
+  double angle;
+  HingeVector gradient;
+};
+DihedralAngleAndGradient dihedral_angle_and_gradient(const HingePositions& x);
+
+/// θ, or nothing for a degenerate hinge (is_degenerate_hinge), from one evaluation of the
+/// hinge's edge and normals.
+std::optional<double> regular_dihedral_angle(const HingePositions& x);
 
 /// ∂²θ/∂(x1,x2,x3)² with x0 fixed: the differential of the gradient formulas above
 /// (normals n_i/|n_i|², edge length and foot parameters α_i differentiated in closed form).

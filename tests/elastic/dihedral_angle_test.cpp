@@ -101,6 +101,21 @@ TEST(DihedralAngle, DegenerateHingeHasNoDerivatives) {
   EXPECT_EQ(dihedral_angle(x), 0.0);
   EXPECT_THROW(dihedral_angle_gradient(x), NumericalError);
   EXPECT_THROW(dihedral_angle_relative_hessian(x), NumericalError);
+  EXPECT_THROW(dihedral_angle_and_gradient(x), NumericalError);
+  EXPECT_FALSE(regular_dihedral_angle(x).has_value());
+}
+
+TEST(DihedralAngle, FusedEvaluationsEqualTheSeparateOnes) {
+  // One hinge frame shared by angle and gradient gives bit for bit the same numbers.
+  std::mt19937 rng(6);
+  for (double fold : test::kFolds) {
+    const HingePositions x = test::folded_hinge(fold, rng);
+    const auto [angle, gradient] = dihedral_angle_and_gradient(x);
+    EXPECT_EQ(angle, dihedral_angle(x));
+    EXPECT_TRUE((gradient == dihedral_angle_gradient(x)));
+    ASSERT_TRUE(regular_dihedral_angle(x).has_value());
+    EXPECT_EQ(*regular_dihedral_angle(x), dihedral_angle(x));
+  }
 }
 
 }  // namespace
