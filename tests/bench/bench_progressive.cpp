@@ -13,6 +13,7 @@
 //                          [--preview-tolerance T] [--preview-iterations K]
 //                          [--scenes drape,twist,cylinder_compress]
 //                          [--preview-only 1]   (level 0 only, no direct solves)
+//                          [--direct 0]         (all levels, no direct solves or errors)
 
 #include <fmt/format.h>
 
@@ -96,7 +97,7 @@ Sample sample_at(const psq::TriMesh& rest, const psq::Positions& deformed,
 }
 
 void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings,
-               bool preview_only) {
+               bool preview_only, bool direct_solves) {
   auto start = Clock::now();
   psq::ProgressiveSimulation sim(scene, settings);
   const double hierarchy_seconds = seconds_since(start);
@@ -140,7 +141,11 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
     sim.refine();
   }
 
-  if (preview_only) return;
+  if (preview_only || !direct_solves) {
+    std::cout << fmt::format("  progressive: preview {:.2f} s, total {:.2f} s\n", preview_seconds,
+                             preview_only ? preview_seconds : total_seconds);
+    return;
+  }
   const psq::ShellSystem& fine = sim.finest_system();
   start = Clock::now();
   const psq::test::DirectRun direct = psq::test::settled_direct_run(fine, sim.finest_tolerance());
@@ -196,9 +201,10 @@ int bench_progressive(const psq::bench::BenchOptions& options) {
   if (gradient != "exact" && gradient != "held")
     psq::bench::reject_value("gradient", gradient, "exact or held");
   const std::vector<std::string> scenes = options.texts("scenes");
-  const int preview_only = options.integer("preview-only");
+  const int preview_only = options.integer("preview-only"), direct = options.integer("direct");
   if (preview_only != 0 && preview_only != 1)
     psq::bench::reject_value("preview-only", std::to_string(preview_only), "0 or 1");
+  if (direct != 0 && direct != 1) psq::bench::reject_value("direct", std::to_string(direct), "0 or 1");
   std::cout << fmt::format(
       "bench_progressive: ~{} fine vertices, {} levels, {} frames, {} gradient\n", vertices, levels,
       frames, gradient);
@@ -212,7 +218,7 @@ int bench_progressive(const psq::bench::BenchOptions& options) {
       settings.schedule.preview_iterations = options.integer("preview-iterations");
     settings.gradient =
         gradient == "exact" ? psq::ProxyGradient::exact : psq::ProxyGradient::held_offsets;
-    run_scene(scene, settings, preview_only == 1);
+    run_scene(scene, settings, preview_only == 1, direct == 1);
   }
   return 0;
 }
@@ -233,6 +239,8 @@ int main(int argc, char** argv) {
        {"preview-iterations", OptionType::count, "",
         "Newton-type iterations per preview step at most (default: the scene's, 2)"},
        {"scenes", OptionType::text_list, "drape,twist,cylinder_compress", "library scenes"},
-       {"preview-only", OptionType::integer, "0", "1: level 0 only, no direct solves"}});
+       {"preview-only", OptionType::integer, "0", "1: level 0 only, no direct solves"},
+       {"direct", OptionType::integer, "1",
+        "0: no direct solves and no errors, only the progressive run"}});
   return psq::bench::run_benchmark(options, argc, argv, bench_progressive);
 }
