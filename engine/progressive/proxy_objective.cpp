@@ -38,44 +38,45 @@ ProxyObjective::ProxyObjective(const ShellSystem& level, const ShellSystem& fine
     bending_scale_.push_back(bending_stiffening(level.shells()[s], finest.shells()[s]));
 }
 
-const Eigen::VectorXd& ProxyObjective::prolonged(const Eigen::VectorXd& x) const {
-  // Bitwise equality, so a hit returns exactly what apply(x) would (a non-finite x, which apply
-  // rejects, is never stored). Comparing 3n numbers is cheap next to prolonging 3m of them.
-  const bool hit = prolonged_at_.size() > 0 && x.size() == prolonged_at_.size() &&
-                   std::memcmp(x.data(), prolonged_at_.data(),
+ProxyObjective::FineEvaluation& ProxyObjective::at(const Eigen::VectorXd& x) const {
+  const bool hit = memo_.x.size() > 0 && x.size() == memo_.x.size() &&
+                   std::memcmp(x.data(), memo_.x.data(),
                                sizeof(double) * static_cast<std::size_t>(x.size())) == 0;
   if (!hit) {
-    prolonged_ = to_finest_.apply(x);
-    prolonged_at_ = x;
+    memo_ = FineEvaluation{};
+    memo_.prolonged = to_finest_.apply(x);
+    memo_.x = x;
   }
-  return prolonged_;
+  return memo_;
+}
+
+double ProxyObjective::elastic_at(FineEvaluation& fine) const {
+  if (!fine.elastic) fine.elastic = fine_elastics(finest_, fine.prolonged);
+  return *fine.elastic;
 }
 
 double ProxyObjective::elastic_energy(const Eigen::VectorXd& x) const {
-  return fine_elastics(finest_, prolonged(x));
+  return elastic_at(at(x));
 }
 
 double ProxyObjective::value(const Eigen::VectorXd& x) {
   const Eigen::VectorXd dx = x - previous_;
   const double inertia = 0.5 * inertia_weight_ * dx.dot(level_.dof_masses().cwiseProduct(dx));
-  const Eigen::VectorXd& fine = prolonged(x);
-  return inertia + fine_elastics(finest_, fine) - finest_.external_force().dot(fine);
-}
-
-Eigen::VectorXd ProxyObjective::fine_gradient(const Eigen::VectorXd& fine) const {
-  Eigen::VectorXd g = -finest_.external_force();
-  for (const auto& m : finest_.membranes()) m.add_gradient(fine, g);
-  for (const auto& b : finest_.bendings()) b.add_gradient(fine, g);
-  return g;
+  FineEvaluation& fine = at(x);
+  return inertia + elastic_at(fine) - finest_.external_force().dot(fine.prolonged);
 }
 
 void ProxyObjective::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-  const Eigen::VectorXd fine_g = fine_gradient(prolonged(x));
-  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_);
-  if (gradient_kind_ == ProxyGradient::exact)
-    g += to_finest_.apply_jacobian_transpose(x, fine_g);
-  else
-    g += to_finest_.apply_linear_transpose(fine_g);
+  FineEvaluation& fine = at(x);
+  if (!fine.pulled) {
+    Eigen::VectorXd fine_g = -finest_.external_force();
+    for (const auto& m : finest_.membranes()) m.add_gradient(fine.prolonged, fine_g);
+    for (const auto& b : finest_.bendings()) b.add_gradient(fine.prolonged, fine_g);
+    fine.pulled = gradient_kind_ == ProxyGradient::exact
+                      ? to_finest_.apply_jacobian_transpose(x, fine_g)
+                      : to_finest_.apply_linear_transpose(fine_g);
+  }
+  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_) + *fine.pulled;
 }
 
 void ProxyObjective::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {

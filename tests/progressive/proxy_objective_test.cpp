@@ -97,6 +97,35 @@ TEST(ProxyObjective, ValueIsTheFineEnergyOfTheProlongedState) {
   EXPECT_EQ(H.batches.size(), 2u);
 }
 
+TEST(ProxyObjective, RememberedFineEvaluationsEqualFreshOnes) {
+  // The proxy remembers the fine part at the last x; a new xᵗ or Δt, or another x in between,
+  // must give exactly what a fresh objective computes.
+  ProxyFixture f;
+  ProxyObjective reused = f.objective(ProxyGradient::exact);
+  const Eigen::VectorXd x = f.deformed();
+  const Eigen::VectorXd other = x + 1e-4 * Eigen::VectorXd::Ones(x.size());
+  Eigen::VectorXd g;
+  (void)reused.value(x);
+  reused.gradient(x, g);
+  (void)reused.elastic_energy(x);
+  const Eigen::VectorXd new_previous = x - 1e-3 * Eigen::VectorXd::Ones(x.size());
+  reused.set_time_step(0.5 * f.cylinder.scene.time.step);
+  reused.set_previous(new_previous);
+
+  ProxyObjective fresh(f.coarse, f.finest, f.to_finest, 0.5 * f.cylinder.scene.time.step,
+                       ProxyGradient::exact);
+  fresh.set_previous(new_previous);
+  Eigen::VectorXd g_reused, g_fresh;
+  for (const Eigen::VectorXd* at : {&x, &other, &x}) {
+    EXPECT_EQ(reused.value(*at), fresh.value(*at));
+    reused.gradient(*at, g_reused);
+    fresh.gradient(*at, g_fresh);
+    EXPECT_TRUE((g_reused == g_fresh));
+    EXPECT_EQ(reused.elastic_energy(*at), fresh.elastic_energy(*at));
+  }
+  EXPECT_NE(reused.value(x), reused.value(other));
+}
+
 /// vᵀ(Σ element blocks)v: the curvature of the blocks' quadratic form along v.
 double element_curvature(const ElementMatrices& blocks, const Eigen::VectorXd& v) {
   double sum = 0.0;
