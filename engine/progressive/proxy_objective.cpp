@@ -87,8 +87,8 @@ void ProxyObjective::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
     level_.membranes()[s].hessian(x, H.batches[2 * s]);
     ElementMatrices& bending = H.batches[2 * s + 1];
     level_.bendings()[s].hessian(x, bending);
-    Eigen::Map<Eigen::VectorXd>(bending.values.data(), static_cast<Eigen::Index>(bending.values.size())) *=
-        bending_scale_[s];
+    Eigen::Map<Eigen::VectorXd>(bending.values.data(),
+                                static_cast<Eigen::Index>(bending.values.size())) *= bending_scale_[s];
   }
 }
 

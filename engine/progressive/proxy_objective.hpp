@@ -2,12 +2,12 @@
 // The coarse-level proxy of the fine incremental potential (paper eqs. 2–3, §4.5):
 //   F(x_l) = 1/(2Δt²)‖x_l − x_lᵗ‖²_{M_l} + Ψ_L(P^l(x_l)) − f_L·P^l(x_l),
 // fine-scale elastics Ψ_L and external force f_L evaluated through the direct prolongation P^l,
-// level-l masses M_l. Newton-type steps use level l's own projected Hessian as preconditioner,
+// level-l masses M_l. Newton-type steps use the exact gradient or the paper's eq.-10 gradient
+// with the offsets held, and level l's own projected Hessian as preconditioner,
 //   H(x_l) = M_l/Δt² + PSD(∇²E_membrane,l(x_l)) + s_l·PSD(∇²E_bending,l(x_l)),
-// with the bending part scaled by s_l, about how much stiffer the fine bending through P^l is
+// its bending part scaled by s_l, about how much stiffer the fine bending through P^l is
 // (√(fine / level triangles), the coarse/fine edge-length ratio): without it the steps
 // overshoot and the line search backtracks.
-// and either the exact gradient or the paper's eq.-10 gradient with the offsets held.
 
 #include "engine/progressive/level_objective.hpp"
 #include "engine/progressive/system_prolongation.hpp"
