@@ -51,6 +51,34 @@ TEST(ElementLoop, GradientScatterEqualsTheSerialScatterBitForBit) {
   }
 }
 
+TEST(ElementLoop, NestedGradientScattersOnOneThreadKeepTheirOwnBuffers) {
+  // An element gradient that itself runs a gradient loop (as a TBB thread waiting in one loop
+  // may run another loop's task): the inner loop must not overwrite the outer one's buffer.
+  const std::vector<int> outer_stencils = random_stencils(3);
+  const std::vector<int> inner_stencils(3 * 64, 0);
+  const auto inner_sum = [&]() {
+    Eigen::VectorXd inner = Eigen::VectorXd::Zero(3 * kVertices);
+    // Other values than the outer loop's first elements, so that an overwrite would show.
+    add_element_gradients<3>(
+        inner_stencils, [](std::size_t e) { return element_gradient(e + 7919); }, inner);
+    return inner[0];
+  };
+  const double inner_first = inner_sum();
+  Eigen::VectorXd expected = Eigen::VectorXd::Zero(3 * kVertices);
+  add_element_gradients<3>(outer_stencils, element_gradient, expected);
+
+  Eigen::VectorXd nested = Eigen::VectorXd::Zero(3 * kVertices);
+  add_element_gradients<3>(
+      outer_stencils,
+      [&](std::size_t e) -> Eigen::Matrix<double, 9, 1> {
+        // Every 1000th element runs the inner loop; its value is known, so it adds nothing.
+        if (e % 1000 == 0 && inner_sum() != inner_first) return Eigen::Matrix<double, 9, 1>::Ones();
+        return element_gradient(e);
+      },
+      nested);
+  EXPECT_TRUE((nested.array() == expected.array()).all());
+}
+
 TEST(ElementLoop, HessianFillWritesEveryBlockAndKeepsMatchingStorage) {
   const std::vector<int> stencils = random_stencils(2);
   const auto block = [](std::size_t e) {
