@@ -67,16 +67,13 @@ double ProxyObjective::value(const Eigen::VectorXd& x) {
 }
 
 void ProxyObjective::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-  FineEvaluation& fine = at(x);
-  if (!fine.pulled) {
-    Eigen::VectorXd fine_g = -finest_.external_force();
-    for (const auto& m : finest_.membranes()) m.add_gradient(fine.prolonged, fine_g);
-    for (const auto& b : finest_.bendings()) b.add_gradient(fine.prolonged, fine_g);
-    fine.pulled = gradient_kind_ == ProxyGradient::exact
-                      ? to_finest_.apply_jacobian_transpose(x, fine_g)
-                      : to_finest_.apply_linear_transpose(fine_g);
-  }
-  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_) + *fine.pulled;
+  const Eigen::VectorXd& fine = at(x).prolonged;
+  Eigen::VectorXd fine_g = -finest_.external_force();
+  for (const auto& m : finest_.membranes()) m.add_gradient(fine, fine_g);
+  for (const auto& b : finest_.bendings()) b.add_gradient(fine, fine_g);
+  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_) +
+      (gradient_kind_ == ProxyGradient::exact ? to_finest_.apply_jacobian_transpose(x, fine_g)
+                                              : to_finest_.apply_linear_transpose(fine_g));
 }
 
 void ProxyObjective::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
