@@ -93,6 +93,9 @@ nlohmann::json run_summary(const Scene& scene, const TriMesh& rest, double toler
           {"triangles", rest.triangle_count()},
           {"time_step", scene.time.step},
           {"tolerance", tolerance},
+          {"frame_solution", scene.solver.frame_solution == FrameSolution::equilibrium
+                                 ? "equilibrium"
+                                 : "fixed_step"},
           {"level_count", level_count},
           {"all_converged", all_converged},
           {"frames", frames}};
@@ -141,11 +144,14 @@ int run_direct(const Scene& scene, const SimOptions& sim_options) {
     write_positions(frame_path(out, record.frame), rest, sim.positions());
     all_converged = all_converged && record.newton.converged;
     frames.push_back(frame_json(record));
-    std::cerr << fmt::format("{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}, {:.3f} s\n",
-                             terminal ? "\r" : "", record.frame, sim.frame_count(),
-                             record.newton.iterations,
-                             record.newton.converged ? "converged" : "NOT converged",
-                             record.newton.step_norm, record.newton.wall_seconds);
+    std::cerr << fmt::format(
+        "{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}{}, {:.3f} s\n", terminal ? "\r" : "",
+        record.frame, sim.frame_count(), record.newton.iterations,
+        record.newton.converged ? "converged" : "NOT converged", record.newton.step_norm,
+        record.settle_steps > 0 ? fmt::format(", {} settling steps, static residual {:.3e}",
+                                              record.settle_steps, record.static_residual)
+                                : "",
+        record.newton.wall_seconds);
   }
   return finish(out,
                 run_summary(scene, rest, sim.newton_settings().tolerance, 1, all_converged, frames),

@@ -1,5 +1,7 @@
 #include "runner/stats_json.hpp"
 
+#include <cmath>
+
 namespace psq::runner {
 
 nlohmann::json phase_times_json(const PhaseTimes& t) {
@@ -45,6 +47,9 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"gradient_norm", r.newton.gradient_norm},
           {"step_norm_history", step_norms},
           {"gradient_norm_history", gradient_norms},
+          {"settle_steps", r.settle_steps},
+          {"static_residual", std::isnan(r.static_residual) ? nlohmann::json(nullptr)
+                                                            : nlohmann::json(r.static_residual)},
           {"friction_iterations", r.friction_iterations},
           {"contact", contact_json(r)},
           {"seconds", r.newton.wall_seconds},

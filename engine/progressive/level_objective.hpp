@@ -2,8 +2,6 @@
 // The objective of one quasistatic step at one level of a progressive solve: an incremental
 // potential centred at the previous step's positions xᵗ.
 
-#include <optional>
-
 #include "engine/sim/incremental_potential.hpp"
 #include "engine/solver/objective.hpp"
 
@@ -13,8 +11,7 @@ class LevelObjective : public Objective {
  public:
   /// The previous step's positions xᵗ (this level's vertices), the centre of the inertia term.
   virtual void set_previous(const Eigen::VectorXd& previous) = 0;
-  /// The pseudo time step Δt of the inertia-like term 1/(2Δt²)‖x − xᵗ‖²_M. Call it before
-  /// set_previous: an implementation may reset xᵗ.
+  /// The pseudo time step Δt of the inertia-like term 1/(2Δt²)‖x − xᵗ‖²_M.
   virtual void set_time_step(double time_step) = 0;
   /// The elastic energy the objective minimizes, at the finest scale, for reports.
   [[nodiscard]] virtual double elastic_energy(const Eigen::VectorXd& x) const = 0;
@@ -26,30 +23,24 @@ class LevelObjective : public Objective {
 class DirectObjective : public LevelObjective {
  public:
   DirectObjective(const ShellSystem& system, double time_step)
-      : system_(system), potential_(std::in_place, system, time_step), time_step_(time_step) {}
+      : potential_(system, time_step) {}
 
   void set_previous(const Eigen::VectorXd& previous) override {
-    potential_->set_previous(previous);
+    potential_.set_previous(previous);
   }
-  void set_time_step(double time_step) override {
-    if (time_step == time_step_) return;
-    potential_.emplace(system_, time_step);  // xᵗ is reset to the rest state: set it afterwards
-    time_step_ = time_step;
-  }
+  void set_time_step(double time_step) override { potential_.set_time_step(time_step); }
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override {
-    return potential_->elastic_energy(x);
+    return potential_.elastic_energy(x);
   }
-  [[nodiscard]] Eigen::Index size() const override { return potential_->size(); }
-  double value(const Eigen::VectorXd& x) override { return potential_->value(x); }
+  [[nodiscard]] Eigen::Index size() const override { return potential_.size(); }
+  double value(const Eigen::VectorXd& x) override { return potential_.value(x); }
   void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
-    potential_->gradient(x, g);
+    potential_.gradient(x, g);
   }
-  void hessian(const Eigen::VectorXd& x, HessianBlocks& H) override { potential_->hessian(x, H); }
+  void hessian(const Eigen::VectorXd& x, HessianBlocks& H) override { potential_.hessian(x, H); }
 
  private:
-  const ShellSystem& system_;
-  std::optional<IncrementalPotential> potential_;  ///< rebuilt when Δt changes
-  double time_step_;
+  IncrementalPotential potential_;
 };
 
 }  // namespace psq

@@ -1,8 +1,5 @@
 #include "engine/progressive/level_stepper.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 namespace psq {
 
 LevelStepper::LevelStepper(const ShellSystem& system, std::unique_ptr<LevelObjective> objective,
@@ -11,19 +8,6 @@ LevelStepper::LevelStepper(const ShellSystem& system, std::unique_ptr<LevelObjec
       objective_(std::move(objective)),
       dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()),
       settings_(settings) {}
-
-double settling_time_step(double time_step, int settle_step) {
-  return time_step * std::pow(4.0, std::min(settle_step, kSettlingGrowthSteps));
-}
-
-bool settling_done(int settle_step, double change, double tolerance) {
-  return settle_step >= kSettlingGrowthSteps && change < tolerance;
-}
-
-int next_settling_growth(int growth, const NewtonResult& newton) {
-  const bool nothing_to_solve = newton.converged && newton.iterations == 0;
-  return nothing_to_solve ? std::max(growth + 1, kSettlingGrowthSteps) : growth + 1;
-}
 
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
                                const NewtonSolver::Progress& progress) {

@@ -7,25 +7,10 @@
 
 #include "engine/progressive/level_objective.hpp"
 #include "engine/sim/quasistatic.hpp"
+#include "engine/sim/settling.hpp"
 #include "engine/solver/newton.hpp"
 
 namespace psq {
-
-/// Pseudo time step of settling step k = 0, 1, … (steps at one frame, loading held, until
-/// equilibrium): Δt·4^k, at most Δt·4^kSettlingGrowthSteps. A fixed Δt stalls in soft directions
-/// (each step moves them by their stiffness over M/Δt², so steps get small long before the
-/// equilibrium is reached); growing steps fade the inertia-like term.
-double settling_time_step(double time_step, int settle_step);
-inline constexpr int kSettlingGrowthSteps = 6;
-/// Settling ends at the first step taken at the largest time step whose change
-/// ‖x − xᵗ‖∞/Δt is below the tolerance: only then is a small change a small distance to the
-/// equilibrium.
-bool settling_done(int settle_step, double change, double tolerance);
-/// The settling time step index after a step at index `growth` solved by `newton`: one more,
-/// or kSettlingGrowthSteps at once when that step had nothing to solve (converged at its start)
-/// — the inertia-like term no longer held anything back, and growing Δt 4× at a time would only
-/// cost one more Hessian and factorization per step.
-int next_settling_growth(int growth, const NewtonResult& newton);
 
 class LevelStepper {
  public:

@@ -21,7 +21,8 @@ constexpr const char* kFramesDone = "progressive.frames_done";
 constexpr const char* kSettleSteps = "progressive.settle_steps";
 constexpr const char* kSettleGrowth = "progressive.settle_growth";
 constexpr const char* kSettled = "progressive.settled";
-constexpr const char* kLevelConverged = "progressive.level_converged";
+constexpr const char* kLevelConverged = "progressive.level_converged";  // before settling_failed
+constexpr const char* kSettlingFailed = "progressive.settling_failed";
 
 void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
   const auto fail = [&](const std::string& what) {
@@ -164,8 +165,9 @@ void ProgressiveSimulation::enter_level(int level) {
         level_newton_settings(level));
   }
   level_ = level;
-  settled_ = false;
-  level_converged_ = false;
+  // Level 0 starts at the rest state (frame 0); a finer level at the refine frame, to be settled.
+  settled_ = level == 0;
+  settling_failed_ = false;
   settle_steps_ = 0;
   settle_growth_ = 0;
 }
@@ -176,7 +178,14 @@ double ProgressiveSimulation::tolerance() const { return stepper_->settings().to
 
 bool ProgressiveSimulation::level_done() const {
   const int last_frame = finest_level() ? frame_count() : refine_frame_;
-  return frame_ == last_frame && (!settles() || settled_);
+  return frame_ == last_frame && settled_;
+}
+
+bool ProgressiveSimulation::frame_settles(int frame) const {
+  const bool refine_frame_of_hierarchy = settles() && frame == refine_frame_;
+  const bool finest_equilibrium =
+      finest_level() && finest_.scene().solver.frame_solution == FrameSolution::equilibrium;
+  return refine_frame_of_hierarchy || finest_equilibrium;
 }
 
 Eigen::VectorXd ProgressiveSimulation::finest_positions() const {
@@ -188,7 +197,7 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     throw std::logic_error(fmt::format("ProgressiveSimulation::step: level {} is done", level_));
   ProgressiveStep out;
   out.level = level_;
-  out.settling = settles() && frame_ == refine_frame_ && !settled_;
+  out.settling = !settled_;
   const int frame = out.settling ? frame_ : frame_ + 1;
   const double time_step = out.settling
                                ? settling_time_step(finest_.scene().time.step, settle_growth_)
@@ -202,11 +211,20 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
                              });
   out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
+  const bool converged_at_start = out.frame.newton.converged && out.frame.newton.iterations == 0;
   if (out.settling) {
-    level_converged_ = settling_done(settle_growth_, out.change, tolerance());
+    const bool done = settling_done(settle_growth_, out.change, tolerance());
     ++settle_steps_;
-    settle_growth_ = next_settling_growth(settle_growth_, out.frame.newton);
-    settled_ = level_converged_ || settle_steps_ >= settings_.max_settle_steps;
+    settle_growth_ = next_settling_growth(settle_growth_, converged_at_start);
+    settled_ = done || settle_steps_ >= settings_.max_settle_steps;
+    if (settled_ && !done) settling_failed_ = true;
+    out.equilibrium = done;
+    if (done) out.frame.static_residual = out.frame.newton.step_norm;
+  } else {
+    // The frame's step is the settling schedule's first, at Δt.
+    settled_ = !frame_settles(frame);
+    settle_steps_ = 0;
+    settle_growth_ = next_settling_growth(0, converged_at_start);
   }
   return out;
 }
@@ -229,7 +247,7 @@ std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
           {kSettleSteps, settle_steps_},
           {kSettleGrowth, settle_growth_},
           {kSettled, settled_ ? 1.0 : 0.0},
-          {kLevelConverged, level_converged_ ? 1.0 : 0.0}};
+          {kSettlingFailed, settling_failed_ ? 1.0 : 0.0}};
 }
 
 void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd& positions,
@@ -262,21 +280,22 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
     return found->second;
   };
   const auto frames_done = stored(kFramesDone), settle_steps = stored(kSettleSteps),
-             settled = stored(kSettled), converged = stored(kLevelConverged);
-  if (frames_done && settle_steps && settled && converged) {
+             settled = stored(kSettled), failed = stored(kSettlingFailed),
+             converged = stored(kLevelConverged);
+  if (frames_done && settle_steps && settled && (failed || converged)) {
     frame_ = static_cast<int>(*frames_done);
     settle_steps_ = static_cast<int>(*settle_steps);
     // Stores written before the growth index existed grew Δt once per settling step.
     settle_growth_ = static_cast<int>(
         stored(kSettleGrowth).value_or(std::min(settle_steps_, kSettlingGrowthSteps)));
     settled_ = *settled != 0.0;
-    level_converged_ = *converged != 0.0;
+    // Stores written before settling_failed kept whether the level's one settling converged.
+    settling_failed_ = failed ? *failed != 0.0 : settled_ && *converged == 0.0;
     resumed_iterations_ = iterations_in_frame;
     return;
   }
   frame_ = frame;
-  settled_ = !settles() || frame > refine_frame_;
-  level_converged_ = settled_;
+  settled_ = !frame_settles(frame) || (settles() && frame > refine_frame_);
 }
 
 }  // namespace psq

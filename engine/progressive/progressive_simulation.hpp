@@ -13,8 +13,9 @@
 //   intermediate levels: settling steps at the refine frame as above;
 //   finest level: settling steps with the true incremental potential, each solved to the
 //     scene's tolerance, until the change is below that tolerance; then frames
-//     refine_frame+1..frames, one converged step each.
-// With levels = 1 the finest level steps frames 1..frames exactly like QuasistaticSimulation.
+//     refine_frame+1..frames, each one converged step and (the scene's frame_solution =
+//     equilibrium) its settling steps.
+// With levels = 1 the finest level steps frames 1..frames as QuasistaticSimulation does.
 
 #include <filesystem>
 #include <functional>
@@ -53,6 +54,8 @@ struct ProgressiveStep {
   int level = 0;
   /// A step at the refine frame with the loading held (frame.frame does not advance).
   bool settling = false;
+  /// A settling step that passed the equilibrium test (settling_done): its frame is settled.
+  bool equilibrium = false;
   double change = 0.0;  ///< ‖x − xᵗ‖∞/Δt of this step
   /// Frame, time, fine-scale elastic energy (Ψ_L(P^l(x))), Newton history and timings.
   FrameRecord frame;
@@ -81,12 +84,15 @@ class ProgressiveSimulation {
   [[nodiscard]] int frame_count() const { return finest_.scene().time.frames; }
   [[nodiscard]] int refine_frame() const { return refine_frame_; }
   [[nodiscard]] bool level_done() const;
+  /// The frame reached needs no more settling steps (the next step, if any, is a new frame's).
+  [[nodiscard]] bool frame_settled() const { return settled_; }
   [[nodiscard]] bool finished() const { return finest_level() && level_done(); }
   /// The current level is the finest: its steps must converge, while coarser levels are
   /// previews whose steps may stop at preview_iterations.
   [[nodiscard]] bool finest_level() const { return level_ + 1 == level_count_; }
-  /// Whether the current level's settling met its tolerance (rather than max_settle_steps).
-  [[nodiscard]] bool level_converged() const { return level_converged_; }
+  /// Whether the current level is done and every settling of its frames met its tolerance
+  /// (rather than stopping at max_settle_steps).
+  [[nodiscard]] bool level_converged() const { return level_done() && !settling_failed_; }
 
   /// Tolerance on ‖d‖∞/Δt (and on the settling change) at the current level.
   [[nodiscard]] double tolerance() const;
@@ -104,6 +110,9 @@ class ProgressiveSimulation {
   /// P^l(x_l) on the finest mesh; positions() itself at the finest level.
   [[nodiscard]] Eigen::VectorXd finest_positions() const;
 
+  /// Whether a step to `frame` at the current level is followed by settling steps: the refine
+  /// frame of a hierarchy, and every frame of the finest level whose frames are equilibria.
+  [[nodiscard]] bool frame_settles(int frame) const;
   /// One quasistatic step of the schedule. @throws std::logic_error when level_done().
   ProgressiveStep step(const Progress& progress = {});
   /// Moves to the next level from the current (done) one. @throws std::logic_error when the
@@ -144,8 +153,10 @@ class ProgressiveSimulation {
 
   int level_ = 0;
   int frame_ = 0;
+  /// The frame reached (frame_) needs no more settling steps.
   bool settled_ = false;
-  bool level_converged_ = false;
+  /// A settling of this level stopped at max_settle_steps without passing its test.
+  bool settling_failed_ = false;
   int settle_steps_ = 0;
   /// Index of the settling time step (settling_time_step, next_settling_growth).
   int settle_growth_ = 0;

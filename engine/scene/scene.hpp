@@ -92,10 +92,24 @@ struct TimeStepping {
   int frames = 25;     ///< number of steps; frame k is at time k·Δt
 };
 
+/// What a frame's answer is (the [solver] table's frame_solution).
+enum class FrameSolution {
+  /// A static equilibrium of the frame's loading: the frame's step from the previous frame, then
+  /// settling steps with the loading held (engine/sim/settling.hpp) until the state is at rest.
+  equilibrium,
+  /// One quasistatic step of Δt from the previous frame, a gradient-flow path: for scenes whose
+  /// path matters (buckling, contact history), where settling every frame would jump to another
+  /// equilibrium than the loading's history leads to. Frames are then not equilibria.
+  fixed_step,
+};
+
 struct SolverSettings {
   /// Converged when ‖Δx‖∞/Δt falls below this [m/s]. Unset: 1e-4 × bounding-box diagonal / s.
   std::optional<double> tolerance;
-  int max_iterations = 200;  ///< Newton iterations per frame before reporting non-convergence
+  /// Newton iterations per frame (its step and its settling steps together) before reporting
+  /// non-convergence.
+  int max_iterations = 200;
+  FrameSolution frame_solution = FrameSolution::equilibrium;
 };
 
 /// The [hierarchy] table: progressive simulation over a coarse-to-fine hierarchy (paper §3,

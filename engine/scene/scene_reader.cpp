@@ -595,9 +595,14 @@ SolverSettings read_solver(const Section& root) {
   SolverSettings solver;
   const auto section = root.optional_table("solver");
   if (!section) return solver;
-  section->allow_only({"tolerance", "max_iterations"});
+  section->allow_only({"tolerance", "max_iterations", "frame_solution"});
   solver.tolerance = read_optional_positive(*section, "tolerance");
   solver.max_iterations = read_count(*section, "max_iterations", solver.max_iterations);
+  solver.frame_solution =
+      read_choice(*section, "frame_solution", {"equilibrium", "fixed_step"}, "equilibrium") ==
+              "fixed_step"
+          ? FrameSolution::fixed_step
+          : FrameSolution::equilibrium;
   return solver;
 }
 

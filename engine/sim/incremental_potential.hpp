@@ -18,6 +18,8 @@ class IncrementalPotential : public Objective {
 
   /// The previous step's positions xᵗ, the centre of the inertia-like term.
   void set_previous(const Eigen::VectorXd& previous) { previous_ = previous; }
+  /// The pseudo time step Δt of the inertia-like term (settling steps grow it).
+  void set_time_step(double time_step) { inertia_weight_ = 1.0 / (time_step * time_step); }
   /// 1/Δt², the weight of the inertia-like term.
   [[nodiscard]] double inertia_weight() const { return inertia_weight_; }
 

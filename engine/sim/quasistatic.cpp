@@ -24,6 +24,9 @@ constexpr int kMaxPullRounds = 6;
 /// may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
+/// adaptive_state()'s name of the settling growth index inside a settling step.
+constexpr const char* kSettleGrowthState = "settling.growth";
+
 /// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
 constexpr int kMaxFrictionIterations = 5;
 
@@ -49,6 +52,20 @@ void apply_pins_checked(Objective& objective, const ShellSystem& system, int fra
         "or stretches to the strain limit triangles next to them; use more frames (smaller "
         "steps of the motion)",
         frame));
+}
+
+/// `progress` with its records numbered through the whole frame, from `taken` iterations on
+/// (those before a restore): a frame takes several Newton solves (pull rounds, κ chunks,
+/// friction iterations, settling steps), and a snapshot's iteration count must cover them all.
+/// Empty when `progress` is.
+NewtonSolver::Progress numbered_through_frame(NewtonSolver::Progress progress, int& taken) {
+  if (!progress) return {};
+  return [progress = std::move(progress), &taken](const NewtonIteration& it) {
+    NewtonIteration numbered = it;
+    numbered.iteration = taken;
+    if (it.step_length > 0.0) ++taken;
+    progress(numbered);
+  };
 }
 
 }  // namespace
@@ -163,18 +180,17 @@ void QuasistaticSimulation::solve_contact_frame(FrameRecord& record, const Newto
   // Without lagged contacts before and after a solve, re-solving would change nothing.
   potential_.add_term(*friction_);
   friction_->reset_seconds();
-  friction_->lag(contact_->potential(), previous_, previous_);
+  friction_->lag(contact_->potential(), previous_, frame_start_);
   Eigen::VectorXd last_solution;
-  while (true) {
+  for (int iteration = 1;; ++iteration) {
     const bool had_contacts = friction_->contact_count() > 0;
     append_solve(record.newton, solve_in_chunks(dofs_, settings, progress));
     ++record.friction_iterations;
     const bool settled =
         last_solution.size() == x_.size() &&
         (x_ - last_solution).lpNorm<Eigen::Infinity>() / settings.step_scale < settings.tolerance;
-    if (!record.newton.converged || settled || record.friction_iterations == kMaxFrictionIterations)
-      break;
-    friction_->lag(contact_->potential(), x_, previous_);
+    if (!record.newton.converged || settled || iteration == kMaxFrictionIterations) break;
+    friction_->lag(contact_->potential(), x_, frame_start_);
     if (!had_contacts && friction_->contact_count() == 0) break;
     last_solution = x_;
   }
@@ -195,30 +211,79 @@ void QuasistaticSimulation::finish_contact_frame(FrameRecord& record) {
   record.contact = contact_->potential().stats();
 }
 
+void QuasistaticSimulation::solve_held_frame(FrameRecord& record, const NewtonSettings& settings,
+                                             const NewtonSolver::Progress& progress) {
+  if (contact_)
+    solve_contact_frame(record, settings, progress);
+  else
+    append_solve(record.newton, solve_in_chunks(dofs_, settings, progress));
+}
+
+void QuasistaticSimulation::settle(FrameRecord& record, const NewtonSettings& settings,
+                                   const NewtonSolver::Progress& progress,
+                                   bool continue_restored) {
+  const double time_step = system_.scene().time.step;
+  for (bool restored = continue_restored;; restored = false) {
+    NewtonSettings budget = settings;
+    budget.max_iterations = settings.max_iterations - record.newton.iterations;
+    if (budget.max_iterations < 1) {
+      record.newton.converged = false;
+      break;
+    }
+    if (!restored) previous_ = x_;
+    potential_.set_previous(previous_);
+    potential_.set_time_step(settling_time_step(time_step, settle_growth_));
+    const int iterations_before = record.newton.iterations;
+    solve_held_frame(record, budget, progress);
+    ++record.settle_steps;
+    const double change = (x_ - previous_).lpNorm<Eigen::Infinity>() / time_step;
+    const bool done = settling_done(settle_growth_, change, settings.tolerance);
+    settle_growth_ = next_settling_growth(
+        settle_growth_, record.newton.converged && record.newton.iterations == iterations_before);
+    if (!record.newton.converged) break;
+    if (done) {
+      record.static_residual = record.newton.step_norm;
+      break;
+    }
+  }
+  settle_growth_ = 0;
+  potential_.set_time_step(time_step);
+}
+
 FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   FrameRecord record;
   record.frame = frame_ + 1;
   record.time = record.frame * system_.scene().time.step;
   const int resumed_iterations = std::exchange(resumed_iterations_, 0);
+  const bool resumed_in_settling = resumed_iterations > 0 && settle_growth_ > 0;
   if (resumed_iterations == 0) previous_ = x_;
+  frame_start_ = previous_;
   potential_.set_previous(previous_);
   const int frame_number = record.frame;
   NewtonSettings settings = settings_;
   settings.max_iterations -= resumed_iterations;
   NewtonSolver::Progress frame_progress;
   if (progress) frame_progress = [&](const NewtonIteration& it) { progress(frame_number, it); };
-  // Numbered within the whole frame, across a restore.
+  int iterations_taken = resumed_iterations;
   const NewtonSolver::Progress counted_progress =
-      offset_progress(frame_progress, resumed_iterations);
+      numbered_through_frame(frame_progress, iterations_taken);
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
-  if (contact_) {
-    begin_contact_frame(record, settings, counted_progress);
-    solve_contact_frame(record, settings, counted_progress);
-    finish_contact_frame(record);
-  } else {
-    apply_pins_checked(potential_, system_, record.frame, x_);
-    record.newton = solve_in_chunks(dofs_, settings, counted_progress);
+  if (!resumed_in_settling) {
+    if (contact_) {
+      begin_contact_frame(record, settings, counted_progress);
+    } else {
+      apply_pins_checked(potential_, system_, record.frame, x_);
+    }
+    solve_held_frame(record, settings, counted_progress);
+    // The frame's step was the settling schedule's first, at Δt.
+    settle_growth_ = next_settling_growth(
+        0, record.newton.converged && record.newton.iterations == 0);
   }
+  if (system_.scene().solver.frame_solution == FrameSolution::equilibrium &&
+      (record.newton.converged || resumed_in_settling))
+    settle(record, settings, counted_progress, resumed_in_settling);
+  settle_growth_ = 0;
+  if (contact_) finish_contact_frame(record);
   record.newton.iterations += resumed_iterations;
   frame_ = record.frame;
   record.elastic_energy = potential_.elastic_energy(x_);
@@ -229,6 +294,7 @@ std::map<std::string, double> QuasistaticSimulation::adaptive_state() const {
   std::map<std::string, double> state;
   if (contact_) contact_->save_state(state);
   if (strain_limit_) strain_limit_->save_state(state);
+  if (settle_growth_ > 0) state[kSettleGrowthState] = settle_growth_;
   return state;
 }
 
@@ -254,6 +320,8 @@ void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
   previous_ = previous;
   frame_ = in_progress ? frame - 1 : frame;
   resumed_iterations_ = iterations_in_frame;
+  const auto growth = adaptive_state.find(kSettleGrowthState);
+  settle_growth_ = in_progress && growth != adaptive_state.end() ? static_cast<int>(growth->second) : 0;
 }
 
 }  // namespace psq

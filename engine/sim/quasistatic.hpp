@@ -14,6 +14,7 @@
 // step, and κ_s adapts between Newton chunks as κ does with contact.
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -22,6 +23,7 @@
 #include "engine/sim/friction_term.hpp"
 #include "engine/sim/incremental_potential.hpp"
 #include "engine/sim/kinematic_pull.hpp"
+#include "engine/sim/settling.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/newton.hpp"
@@ -33,8 +35,16 @@ struct FrameRecord {
   int frame = 0;      ///< 1-based; frame 0 is the rest state
   double time = 0.0;  ///< frame · Δt
   double elastic_energy = 0.0;
-  /// Every Newton solve of the frame (pull rounds, the solve, re-solves after κ updates).
+  /// Every Newton solve of the frame (pull rounds, the solve, re-solves after κ updates, the
+  /// settling steps). With frame_solution = equilibrium, converged means that the frame's step
+  /// converged and its settling reached the equilibrium within the iteration budget.
   NewtonResult newton;
+  /// Settling steps after the frame's step (0 with frame_solution = fixed_step).
+  int settle_steps = 0;
+  /// ‖d‖∞/Δt of the Newton step of the last settling step (Δt·4⁶, a nearly inertia-free step) at
+  /// the frame's answer: its distance to the static equilibrium, in the tolerance's measure. NaN
+  /// when the frame was not settled (fixed_step, or its step or settling did not converge).
+  double static_residual = std::numeric_limits<double>::quiet_NaN();
   // Contact scenes only (zero otherwise):
   ContactStats contact;          ///< barrier and CCD work, with the skips
   double barrier_stiffness = 0;  ///< κ at the end of the frame
@@ -49,6 +59,9 @@ struct FrameRecord {
   int friction_iterations = 0;
   double friction_seconds = 0;  ///< lagging and evaluating friction (within assembly, line search)
 };
+
+/// Every frame's answer is a static equilibrium (settling.hpp) unless the scene's
+/// frame_solution is fixed_step.
 
 /// One quasistatic step without adaptive terms (no contact, no strain limit), as the levels of a
 /// progressive solve take it; QuasistaticSimulation takes the same step for such scenes (its
@@ -88,13 +101,15 @@ class QuasistaticSimulation {
   /// The strain-limit term, or null when no shell sets a strain limit.
   [[nodiscard]] StrainLimitTerm* strain_limit() { return strain_limit_.get(); }
 
-  /// Solves the next frame. A frame that does not converge within the iteration limit is
-  /// returned with newton.converged = false; numerical failures throw NumericalError.
+  /// Solves the next frame: its step, then (frame_solution = equilibrium) its settling steps. A
+  /// frame that does not converge, or does not settle, within solver.max_iterations is returned
+  /// with newton.converged = false; numerical failures throw NumericalError.
   FrameRecord step(const Progress& progress = {});
 
   /// The adaptive stiffnesses reached so far (contact κ and its range, each limited shell's κ_s
-  /// and last slack), by name: with positions, what a stored state needs besides the frame.
-  /// Empty for a scene without contact or strain limits.
+  /// and last slack) and, inside a settling step, its growth index, by name: with positions,
+  /// what a stored state needs besides the frame. Empty for a scene without contact or strain
+  /// limits between frames.
   [[nodiscard]] std::map<std::string, double> adaptive_state() const;
 
   /// Continues from a saved state, exactly as if the run had not stopped. With
@@ -130,6 +145,15 @@ class QuasistaticSimulation {
                            const NewtonSolver::Progress& progress);
   /// The frame's contact statistics.
   void finish_contact_frame(FrameRecord& record);
+  /// One solve of the frame with its pinned vertices where they are (with contact: the friction
+  /// loop and κ updates), appended to record.newton.
+  void solve_held_frame(FrameRecord& record, const NewtonSettings& settings,
+                        const NewtonSolver::Progress& progress);
+  /// Settling steps at the frame's loading (settling.hpp) from growth index settle_growth_
+  /// until the equilibrium test passes or record.newton has used settings.max_iterations. With
+  /// `continue_restored`, the first step continues a restored one (xᵗ = previous_).
+  void settle(FrameRecord& record, const NewtonSettings& settings,
+              const NewtonSolver::Progress& progress, bool continue_restored);
 
   ShellSystem system_;
   IncrementalPotential potential_;
@@ -142,9 +166,16 @@ class QuasistaticSimulation {
   NewtonSettings settings_;
   Eigen::VectorXd x_;
   Eigen::VectorXd previous_;
+  /// The state the frame started from: friction's slip is measured from it through the frame's
+  /// step and its settling steps, so that static friction holds a settled state instead of
+  /// letting it creep by up to the slip threshold per settling step. After a restore inside a
+  /// frame, the restored xᵗ.
+  Eigen::VectorXd frame_start_;
   int frame_ = 0;
   /// Newton iterations already spent on frame_ + 1 before a restore (0: start it afresh).
   int resumed_iterations_ = 0;
+  /// Growth index of the settling step being solved; 0 outside settling (the frame's step).
+  int settle_growth_ = 0;
 };
 
 }  // namespace psq

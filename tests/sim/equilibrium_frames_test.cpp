@@ -1,0 +1,121 @@
+// Frames are static equilibria (scene [solver] frame_solution = "equilibrium", the default): a
+// frame's answer balances the elastic forces against the loads, checked independently of the
+// solver's own measure by summing the elastic gradients and the external force at the answer.
+// A fixed-step frame of the same scene is a transient that does not.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "engine/sim/quasistatic.hpp"
+#include "support/library_scene.hpp"
+
+namespace psq {
+namespace {
+
+/// The library drape (a soft cloth held at two corners under gravity) on a coarse mesh over
+/// `frames` frames: each fixed Δt step moves the cloth by Δt²g ≈ 1.6 cm at most, far from its
+/// hanging equilibrium.
+Scene coarse_drape(FrameSolution solution, int frames) {
+  Scene scene = test::library_scene("drape");
+  scene.shells[0].mesh.sheet.edge_length = 0.1;
+  scene.time.frames = frames;
+  scene.solver.frame_solution = solution;
+  scene.solver.max_iterations = 400;
+  return scene;
+}
+
+/// max over free DOFs of |∇(Ψ − f·x)|: the force the state leaves unbalanced [N], from the
+/// system's energies directly (not from the solver's incremental potential).
+double unbalanced_force(const ShellSystem& system, const Eigen::VectorXd& x) {
+  Eigen::VectorXd g = -system.external_force();
+  for (const auto& m : system.membranes()) m.add_gradient(x, g);
+  for (const auto& b : system.bendings()) b.add_gradient(x, g);
+  for (int v : system.pinned_vertex_indices()) g.segment<3>(3 * v).setZero();
+  return g.lpNorm<Eigen::Infinity>();
+}
+
+/// The largest load on one DOF [N]: the scale of the forces a state must balance.
+double largest_load(const ShellSystem& system) {
+  return system.external_force().lpNorm<Eigen::Infinity>();
+}
+
+TEST(EquilibriumFrames, EveryFrameBalancesItsLoads) {
+  QuasistaticSimulation sim(coarse_drape(FrameSolution::equilibrium, 2));
+  for (int frame = 1; frame <= 2; ++frame) {
+    const FrameRecord record = sim.step();
+    ASSERT_TRUE(record.newton.converged) << "frame " << frame;
+    EXPECT_GT(record.settle_steps, 0) << "frame " << frame;
+    ASSERT_TRUE(std::isfinite(record.static_residual));
+    EXPECT_LT(record.static_residual, sim.newton_settings().tolerance);
+    EXPECT_LT(unbalanced_force(sim.system(), sim.positions()), 1e-3 * largest_load(sim.system()))
+        << "frame " << frame;
+  }
+}
+
+TEST(EquilibriumFrames, AFixedStepFrameIsATransient) {
+  QuasistaticSimulation fixed(coarse_drape(FrameSolution::fixed_step, 1));
+  const FrameRecord record = fixed.step();
+  ASSERT_TRUE(record.newton.converged);
+  EXPECT_EQ(record.settle_steps, 0);
+  EXPECT_TRUE(std::isnan(record.static_residual));
+  // Far from balanced: the cloth has fallen one step, not hung.
+  EXPECT_GT(unbalanced_force(fixed.system(), fixed.positions()), 0.1 * largest_load(fixed.system()));
+
+  QuasistaticSimulation settled(coarse_drape(FrameSolution::equilibrium, 1));
+  ASSERT_TRUE(settled.step().newton.converged);
+  const double diagonal = bounding_box_diagonal(settled.system().rest_mesh().vertices);
+  EXPECT_GT((settled.positions() - fixed.positions()).lpNorm<Eigen::Infinity>(), 0.05 * diagonal);
+}
+
+TEST(EquilibriumFrames, ASettlingStepResumesExactly) {
+  const Scene scene = coarse_drape(FrameSolution::equilibrium, 1);
+  QuasistaticSimulation reference(scene);
+  ASSERT_TRUE(reference.step().newton.converged);
+
+  // Interrupted inside a settling step: the state then names its growth index.
+  QuasistaticSimulation interrupted(scene);
+  std::optional<Eigen::VectorXd> positions, previous;
+  std::map<std::string, double> state;
+  int iterations = 0;
+  interrupted.step([&](int, const NewtonIteration& it) {
+    const std::map<std::string, double> now = interrupted.adaptive_state();
+    if (positions || it.step_length <= 0.0 || !now.contains("settling.growth") ||
+        now.at("settling.growth") < 2)
+      return;
+    positions = interrupted.positions();
+    previous = interrupted.previous();
+    state = now;
+    iterations = it.iteration + 1;
+  });
+  ASSERT_TRUE(positions) << "no settling step at growth 2 took an iteration";
+
+  QuasistaticSimulation resumed(scene);
+  resumed.restore(1, *positions, *previous, iterations, state);
+  const FrameRecord record = resumed.step();
+  EXPECT_TRUE(record.newton.converged);
+  EXPECT_EQ(resumed.positions(), reference.positions());
+}
+
+TEST(Settling, TimeStepGrowsFourfoldToItsLargestAndJumpsThereWhenNothingMoves) {
+  EXPECT_EQ(settling_time_step(0.5, 0), 0.5);
+  EXPECT_EQ(settling_time_step(0.5, 2), 8.0);
+  EXPECT_EQ(settling_time_step(0.5, kSettlingGrowthSteps + 3), 0.5 * 4096.0);
+  EXPECT_EQ(next_settling_growth(2, false), 3);
+  EXPECT_EQ(next_settling_growth(2, true), kSettlingGrowthSteps);
+  EXPECT_EQ(next_settling_growth(kSettlingGrowthSteps, true), kSettlingGrowthSteps + 1);
+  EXPECT_FALSE(settling_done(kSettlingGrowthSteps - 1, 0.0, 1.0));
+  EXPECT_FALSE(settling_done(kSettlingGrowthSteps, 1.0, 1.0));
+  EXPECT_TRUE(settling_done(kSettlingGrowthSteps, 0.5, 1.0));
+}
+
+TEST(EquilibriumFrames, SceneKeyChoosesTheFrameSolution) {
+  EXPECT_EQ(test::library_scene("drape").solver.frame_solution, FrameSolution::equilibrium);
+  EXPECT_EQ(test::library_scene("tilted_plane").solver.frame_solution, FrameSolution::fixed_step);
+}
+
+}  // namespace
+}  // namespace psq
