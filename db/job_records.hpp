@@ -100,6 +100,9 @@ struct LevelRecord {
   std::int64_t iterations = 0;
   std::vector<double> residuals;         ///< per iteration (NaN allowed: stored as null)
   std::map<std::string, double> timings;  ///< seconds per named phase
+  /// (frame, static residual ‖d‖∞/Δt) of each frame whose answer was settled to a static
+  /// equilibrium (engine/sim/settling.hpp), in frame order (NaN allowed: stored as null).
+  std::vector<std::pair<int, double>> static_residuals;
   std::string checkpoint_path;            ///< empty if none
   std::string checkpoint_checksum;        ///< of the checkpoint file; empty if none
   std::string error;                      ///< empty unless failed

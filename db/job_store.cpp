@@ -84,7 +84,12 @@ Job read_job(const Statement& row) {
 
 constexpr const char* kLevelColumns =
     "level, status, iterations, residuals, timings, checkpoint_path, checkpoint_checksum, "
-    "error, attempt, updated_at";
+    "error, attempt, updated_at, static_residuals";
+
+/// A stored number: JSON has no NaN or infinity, nlohmann writes them as null, read back as NaN.
+double stored_number(const nlohmann::json& value) {
+  return value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
 
 /// Reads the level columns starting at column `first`.
 LevelRecord read_level(const Statement& row, int first) {
@@ -92,19 +97,18 @@ LevelRecord read_level(const Statement& row, int first) {
   level.level = static_cast<int>(row.integer(first));
   level.status = level_status_from_string(row.text(first + 1));
   level.iterations = row.integer(first + 2);
-  // JSON has no NaN or infinity: nlohmann writes them as null, read back as NaN.
   for (const auto& residual : nlohmann::json::parse(row.text(first + 3)))
-    level.residuals.push_back(residual.is_number() ? residual.get<double>()
-                                                   : std::numeric_limits<double>::quiet_NaN());
+    level.residuals.push_back(stored_number(residual));
   const auto timings = nlohmann::json::parse(row.text(first + 4));
   for (const auto& [phase, seconds] : timings.items())
-    level.timings[phase] =
-        seconds.is_number() ? seconds.get<double>() : std::numeric_limits<double>::quiet_NaN();
+    level.timings[phase] = stored_number(seconds);
   level.checkpoint_path = row.text(first + 5);
   level.checkpoint_checksum = row.text(first + 6);
   level.error = row.text(first + 7);
   level.attempt = row.integer(first + 8);
   level.updated_at = row.real(first + 9);
+  for (const auto& frame : nlohmann::json::parse(row.text(first + 10)))
+    level.static_residuals.emplace_back(frame.at(0).get<int>(), stored_number(frame.at(1)));
   return level;
 }
 
@@ -300,12 +304,13 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
   connection_
       .prepare(
           "REPLACE INTO levels (job_id, level, status, iterations, residuals, timings, "
-          "checkpoint_path, checkpoint_checksum, error, attempt, updated_at) "
-          "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)")
+          "checkpoint_path, checkpoint_checksum, error, attempt, updated_at, static_residuals) "
+          "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)")
       .bind_all(lease.job_id, level.level, to_string(level.status), level.iterations,
                 nlohmann::json(level.residuals).dump(), timings.dump(),
                 unless_empty(level.checkpoint_path), unless_empty(level.checkpoint_checksum),
-                unless_empty(level.error), lease.attempt, now())
+                unless_empty(level.error), lease.attempt, now(),
+                nlohmann::json(level.static_residuals).dump())
       .run();
   if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();

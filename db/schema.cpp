@@ -76,9 +76,16 @@ CREATE TABLE levels (
 ) WITHOUT ROWID;
 )sql";
 
+/// Per frame of a level whose answer was settled, [frame, static residual] (a JSON array of
+/// pairs; the residual null when it is not finite).
+constexpr const char* kStaticResiduals = R"sql(
+ALTER TABLE levels ADD COLUMN static_residuals TEXT NOT NULL DEFAULT '[]';
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
+    Migration{2, "static residuals of the settled frames of each level", kStaticResiduals},
 };
 
 constexpr const char* kVersionTable = R"sql(

@@ -48,6 +48,9 @@ class DirectLevelSolver final : public LevelSolver {
   const TriMesh& level_rest_mesh() const override { return simulation_.system().rest_mesh(); }
   Positions finest_positions() const override { return as_positions(simulation_.positions()); }
 
+  bool settles_frame(int) const override {
+    return simulation_.system().scene().solver.frame_solution == FrameSolution::equilibrium;
+  }
   std::map<std::string, double> state() const override { return simulation_.adaptive_state(); }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
                const Eigen::VectorXd& previous, int iterations_in_frame,
@@ -95,6 +98,7 @@ class ProgressiveLevelSolver final : public LevelSolver {
   Positions finest_positions() const override {
     return as_positions(simulation_.finest_positions());
   }
+  bool settles_frame(int frame) const override { return simulation_.frame_settles(frame); }
   std::map<std::string, double> state() const override { return simulation_.schedule_state(); }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
                const Eigen::VectorXd& previous, int iterations_in_frame,

@@ -95,6 +95,21 @@ IterationRecord iteration_record(int frame, const NewtonIteration& it) {
           .seconds = it.times.total()};
 }
 
+/// (frame, step norm of its last Newton record) of each frame in `iterations` that `solver`
+/// settles: those frames' static residuals.
+std::vector<std::pair<int, double>> static_residuals(const std::vector<IterationRecord>& iterations,
+                                                     const LevelSolver& solver) {
+  std::vector<std::pair<int, double>> residuals;
+  for (const IterationRecord& it : iterations) {
+    if (!solver.settles_frame(it.frame)) continue;
+    if (residuals.empty() || residuals.back().first != it.frame)
+      residuals.emplace_back(it.frame, it.step_norm);
+    else
+      residuals.back().second = it.step_norm;
+  }
+  return residuals;
+}
+
 void add_phase_times(std::map<std::string, double>& timings, const PhaseTimes& times) {
   timings["assembly"] += times.assembly;
   timings["factorization"] += times.factorization;
@@ -379,6 +394,7 @@ class JobRun {
     for (const IterationRecord& it : statistics_.iterations)
       level.residuals.push_back(it.gradient_norm);
     level.timings = statistics_.timings;
+    if (solver_) level.static_residuals = static_residuals(statistics_.iterations, *solver_);
     if (!file.empty()) {
       level.checkpoint_path = fs::absolute(file).lexically_normal().string();
       level.checkpoint_checksum = checksum_text(checksum);

@@ -58,6 +58,10 @@ class LevelSolver {
   [[nodiscard]] virtual const TriMesh& level_rest_mesh() const = 0;
   /// The current level's state prolonged to the finest mesh (positions() at the finest level).
   [[nodiscard]] virtual Positions finest_positions() const = 0;
+  /// Whether frame `frame` of the current level ends with settling steps to a static equilibrium
+  /// (engine/sim/settling.hpp): then the step norm of its last Newton record is its static
+  /// residual.
+  [[nodiscard]] virtual bool settles_frame(int frame) const = 0;
   /// Further state the solver needs to continue exactly, by name (stored in checkpoints as
   /// solver scalars and handed back to restore()); none by default.
   [[nodiscard]] virtual std::map<std::string, double> state() const { return {}; }

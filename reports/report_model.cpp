@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "db/job_store.hpp"
@@ -46,6 +47,9 @@ LevelReport level_from_record(const db::LevelRecord& record) {
   level.timings = record.timings;
   level.seconds = level_seconds(record.timings);
   level.final_residual = final_residual(record.residuals);
+  level.static_residuals = record.static_residuals;
+  if (!record.static_residuals.empty() && std::isfinite(record.static_residuals.back().second))
+    level.static_residual = record.static_residuals.back().second;
   level.checkpoint = record.checkpoint_path;
   level.error = record.error;
   return level;

@@ -37,6 +37,10 @@ struct LevelReport {
   std::map<std::string, double> timings;
   std::optional<double> seconds;         ///< level_seconds(timings), if any timing
   std::optional<double> final_residual;  ///< the last finite residual
+  /// (frame, static residual) of the level's frames settled to a static equilibrium, as stored.
+  std::vector<std::pair<int, double>> static_residuals;
+  /// The static residual of the level's last settled frame, when finite.
+  std::optional<double> static_residual;
   /// max_i ‖P(x_l)_i − x_L,i‖ / diag(x_L): this level's state prolonged to the finest mesh
   /// against the finest level's converged state, relative to the latter's bounding box.
   std::optional<double> error_to_finest;

@@ -41,7 +41,8 @@ Table results_table(const SweepReport& report) {
                              "max_displacement", "elastic_energy", "problems"})
     table.header.push_back(column);
   for (int l = 0; l < report.max_depth; ++l)
-    for (const char* column : {"status", "iterations", "seconds", "residual", "error"})
+    for (const char* column :
+         {"status", "iterations", "seconds", "residual", "static_residual", "error"})
       table.header.push_back(fmt::format("level{}.{}", l, column));
 
   for (const JobReport& job : report.jobs) {
@@ -54,13 +55,14 @@ Table results_table(const SweepReport& report) {
                 exact_number(job.outputs.elastic_energy), joined(job.problems, "; ")});
     for (int l = 0; l < report.max_depth; ++l) {
       if (l >= static_cast<int>(job.levels.size())) {
-        row.insert(row.end(), 5, std::string());
+        row.insert(row.end(), 6, std::string());
         continue;
       }
       const LevelReport& level = job.levels[l];
       row.insert(row.end(),
                  {level.status, std::to_string(level.iterations), exact_number(level.seconds),
-                  exact_number(level.final_residual), exact_number(level.error_to_finest)});
+                  exact_number(level.final_residual), exact_number(level.static_residual),
+                  exact_number(level.error_to_finest)});
     }
     table.rows.push_back(std::move(row));
   }
@@ -89,14 +91,21 @@ Table jobs_table(const SweepReport& report) {
 
 Table levels_table(const SweepReport& report) {
   Table table;
-  table.header = {"#",        "level",           "status",    "iterations", "final residual",
-                  "time (s)", "error to finest", "checkpoint"};
+  table.header = {"#",
+                  "level",
+                  "status",
+                  "iterations",
+                  "final residual",
+                  "static residual (m/s)",
+                  "time (s)",
+                  "error to finest",
+                  "checkpoint"};
   for (const JobReport& job : report.jobs)
     for (const LevelReport& level : job.levels)
       table.rows.push_back({std::to_string(job.number), std::to_string(level.level), level.status,
                             std::to_string(level.iterations), readable_number(level.final_residual),
-                            readable_number(level.seconds), readable_number(level.error_to_finest),
-                            level.checkpoint});
+                            readable_number(level.static_residual), readable_number(level.seconds),
+                            readable_number(level.error_to_finest), level.checkpoint});
   return table;
 }
 

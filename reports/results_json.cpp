@@ -12,12 +12,17 @@ nlohmann::json number_or_null(std::optional<double> value) {
 nlohmann::json level_json(const LevelReport& level) {
   nlohmann::json residuals = nlohmann::json::array();
   for (double residual : level.residuals) residuals.push_back(number_or_null(residual));
+  nlohmann::json static_residuals = nlohmann::json::array();
+  for (const auto& [frame, residual] : level.static_residuals)
+    static_residuals.push_back({frame, number_or_null(residual)});
   return {{"level", level.level},
           {"status", level.status},
           {"iterations", level.iterations},
           {"seconds", number_or_null(level.seconds)},
           {"timings", level.timings},
           {"final_residual", number_or_null(level.final_residual)},
+          {"static_residual", number_or_null(level.static_residual)},
+          {"static_residuals", static_residuals},
           {"error_to_finest", number_or_null(level.error_to_finest)},
           {"checkpoint", level.checkpoint},
           {"error", level.error},

@@ -50,6 +50,15 @@ double final_residual(const db::LevelRecord& level) {
   return level.residuals.empty() ? std::nan("") : level.residuals.back();
 }
 
+/// The static residual of the level's last settled frame; NaN when no frame was settled.
+double static_residual(const db::LevelRecord& level) {
+  return level.static_residuals.empty() ? std::nan("") : level.static_residuals.back().second;
+}
+
+nlohmann::json finite_or_null(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+}
+
 /// CSV field: quoted when it holds a comma, quote or line break.
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
@@ -62,15 +71,17 @@ void print_csv(const std::vector<db::JobResult>& results) {
   const std::vector<std::string> columns = parameter_columns(results);
   std::cout << "job,state,depth";
   for (const std::string& c : columns) std::cout << ',' << csv_field(c);
-  std::cout << ",level,level_status,iterations,final_residual,wall_seconds,checkpoint,error\n";
+  std::cout << ",level,level_status,iterations,final_residual,static_residual,wall_seconds,"
+               "checkpoint,error\n";
   for (const db::JobResult& r : results) {
     std::string prefix = fmt::format("{},{},{}", r.job.id, db::to_string(r.job.state), r.job.depth);
     for (const std::string& c : columns) prefix += "," + csv_field(parameter_value(r.job, c));
-    if (r.levels.empty()) std::cout << prefix << ",,,,,,," << csv_field(r.job.error) << '\n';
+    if (r.levels.empty()) std::cout << prefix << ",,,,,,,," << csv_field(r.job.error) << '\n';
     for (const db::LevelRecord& level : r.levels)
-      std::cout << fmt::format("{},{},{},{},{:.6e},{:.3f},{},{}\n", prefix, level.level,
+      std::cout << fmt::format("{},{},{},{},{:.6e},{:.6e},{:.3f},{},{}\n", prefix, level.level,
                                db::to_string(level.status), level.iterations, final_residual(level),
-                               timing(level, "wall"), csv_field(level.checkpoint_path),
+                               static_residual(level), timing(level, "wall"),
+                               csv_field(level.checkpoint_path),
                                csv_field(level.error.empty() ? r.job.error : level.error));
   }
 }
@@ -81,12 +92,16 @@ nlohmann::json to_json(const std::string& sweep, const std::vector<db::JobResult
     nlohmann::json levels = nlohmann::json::array();
     for (const db::LevelRecord& level : r.levels) {
       nlohmann::json residuals = nlohmann::json::array();
-      for (double value : level.residuals)
-        residuals.push_back(std::isfinite(value) ? nlohmann::json(value) : nlohmann::json());
+      for (double value : level.residuals) residuals.push_back(finite_or_null(value));
+      nlohmann::json settled = nlohmann::json::array();
+      for (const auto& [frame, residual] : level.static_residuals)
+        settled.push_back({frame, finite_or_null(residual)});
       levels.push_back({{"level", level.level},
                         {"status", db::to_string(level.status)},
                         {"iterations", level.iterations},
                         {"residuals", residuals},
+                        {"static_residual", finite_or_null(static_residual(level))},
+                        {"static_residuals", settled},
                         {"timings", level.timings},
                         {"checkpoint", level.checkpoint_path},
                         {"checkpoint_checksum", level.checkpoint_checksum},

@@ -403,6 +403,7 @@ TEST(JobStoreResults, LevelRecordsRoundTripAndLaterAttemptsReplaceThem) {
   LevelRecord coarse = level_record(0, LevelStatus::done, 3);
   coarse.residuals = {1.0, 1e-3, 1e-9};
   coarse.timings = {{"solve", 0.25}, {"checkpoint", 0.01}};
+  coarse.static_residuals = {{2, 1e-6}, {3, 2.5e-7}};
   coarse.checkpoint_path = ".psq/runs/job-0000/level-0.h5";
   coarse.checkpoint_checksum = "sha256:abc";
   store.record_level(first->lease, coarse);
@@ -431,6 +432,7 @@ TEST(JobStoreResults, LevelRecordsRoundTripAndLaterAttemptsReplaceThem) {
   EXPECT_EQ(levels[0].status, LevelStatus::done);
   EXPECT_EQ(levels[0].residuals, coarse.residuals);
   EXPECT_EQ(levels[0].timings, coarse.timings);
+  EXPECT_EQ(levels[0].static_residuals, coarse.static_residuals);
   EXPECT_EQ(levels[0].checkpoint_path, coarse.checkpoint_path);
   EXPECT_EQ(levels[0].checkpoint_checksum, coarse.checkpoint_checksum);
   EXPECT_EQ(levels[0].attempt, 1);  // written by the first attempt, kept
@@ -448,12 +450,18 @@ TEST(JobStoreResults, NonFiniteResidualsSurviveAsNaN) {
   ASSERT_TRUE(claim);
   LevelRecord record = level_record(0, LevelStatus::failed, 2);
   record.residuals = {0.5, std::nan(""), HUGE_VAL};
+  record.static_residuals = {{1, std::nan("")}, {2, 0.5}};
   store.record_level(claim->lease, record);
-  const auto residuals = store.results(JobSelection::job("job-0000"))[0].levels[0].residuals;
+  const LevelRecord stored = store.results(JobSelection::job("job-0000"))[0].levels[0];
+  const auto& residuals = stored.residuals;
   ASSERT_EQ(residuals.size(), 3u);
   EXPECT_EQ(residuals[0], 0.5);
   EXPECT_TRUE(std::isnan(residuals[1]));
   EXPECT_TRUE(std::isnan(residuals[2]));  // JSON has no infinity either
+  ASSERT_EQ(stored.static_residuals.size(), 2u);
+  EXPECT_EQ(stored.static_residuals[0].first, 1);
+  EXPECT_TRUE(std::isnan(stored.static_residuals[0].second));
+  EXPECT_EQ(stored.static_residuals[1], std::make_pair(2, 0.5));
 }
 
 TEST(JobStoreStatus, CountsEveryStatePerSweep) {

@@ -56,6 +56,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     }
     NewtonIteration check;
     check.iteration = iterations_;
+    check.step_norm = 1e-3 * frame;  // the frame's final residual, known from its number
     progress(frame, check);
     frame_ = frame;
     drift_ += 0.25;
@@ -76,6 +77,8 @@ class ScriptedSolver final : public jobs::LevelSolver {
   const Eigen::VectorXd& previous() const override { return previous_; }
   const TriMesh& level_rest_mesh() const override { return rest_; }
   Positions finest_positions() const override { return as_positions(x_); }
+  /// The last frame of each level settles, as a progressive solve's refine frame does.
+  bool settles_frame(int frame) const override { return frame == frames_; }
   std::map<std::string, double> state() const override { return {{"drift", drift_}}; }
   void restore(int level, int frame, const Eigen::VectorXd& positions,
                const Eigen::VectorXd& previous, int iterations_in_frame,
@@ -189,6 +192,10 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
     EXPECT_EQ(level.status, db::LevelStatus::done);
     EXPECT_EQ(level.iterations, kFrames * kIterations);
     EXPECT_EQ(level.residuals.size(), std::size_t(kFrames * (kIterations + 1)));
+    // Only the settled last frame has a static residual: its final record's step norm.
+    ASSERT_EQ(level.static_residuals.size(), 1u);
+    EXPECT_EQ(level.static_residuals[0].first, kFrames);
+    EXPECT_EQ(level.static_residuals[0].second, 1e-3 * kFrames);
     const fs::path file = run_dir().level_checkpoint(level.level);
     EXPECT_EQ(fs::path(level.checkpoint_path), fs::absolute(file));
     // The recorded checksum is the file's: read_checkpoint verifies it.

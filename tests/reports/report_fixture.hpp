@@ -30,6 +30,9 @@ enum class CheckpointCase {
   missing,             ///< recorded, never written
 };
 
+/// The static residual the fixture records for level l's one settled frame.
+inline double fixture_static_residual(int level) { return 1e-7 * (level + 1); }
+
 struct FixtureLevel {
   db::LevelStatus status = db::LevelStatus::done;
   std::vector<double> residuals;
@@ -223,6 +226,7 @@ inline std::filesystem::path make_report_fixture(const std::filesystem::path& di
       record.iterations = static_cast<std::int64_t>(level.residuals.size());
       record.residuals = level.residuals;
       record.timings = level.timings;
+      record.static_residuals = {{1, fixture_static_residual(l)}};
       record.error = level.error;
       if (level.status == db::LevelStatus::done) {
         std::uint64_t checksum = 0x1234;

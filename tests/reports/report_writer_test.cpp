@@ -124,6 +124,8 @@ TEST_F(ReportWriter, CsvHasOneRowPerJobWithTheInputsAndDerivedValues) {
       EXPECT_EQ(row[column(prefix + "status")], db::to_string(level.status));
       EXPECT_EQ(std::stoul(row[column(prefix + "iterations")]), level.residuals.size());
       EXPECT_EQ(std::stod(row[column(prefix + "residual")]), last_finite(level.residuals));
+      EXPECT_EQ(std::stod(row[column(prefix + "static_residual")]),
+                test::fixture_static_residual(l));
       EXPECT_DOUBLE_EQ(std::stod(row[column(prefix + "seconds")]), level.expected_seconds);
       total += level.expected_seconds;
       const std::string error = row[column(prefix + "error")];
@@ -198,7 +200,7 @@ TEST_F(ReportWriter, MarkdownSummaryHasTheTablesAndTheProblems) {
   EXPECT_NE(markdown.find("| 4 | 00000000 | 2 | 0.002 | 1e+07 | failed |"), std::string::npos)
       << markdown;
   EXPECT_NE(markdown.find("Newton diverged at frame 3"), std::string::npos);
-  EXPECT_NE(markdown.find("| 1 | 2 | done | 5 | 3e-08 | 6 | 0 |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("| 1 | 2 | done | 5 | 3e-08 | 3e-07 | 6 | 0 |"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("- job #2 (00000000000000b2): level 1:"), std::string::npos);
   EXPECT_NE(markdown.find("- job #5 (00000000000000e5): level 0:"), std::string::npos);
   EXPECT_EQ(count(markdown, "\n| --- |"), 3u);  // counts, jobs, levels

@@ -38,7 +38,7 @@ TEST_F(ResultsCommand, CsvHasOneRowPerJobLevelWithItsParameters) {
   std::getline(lines, header);
   EXPECT_EQ(header,
             "job,state,depth,shell.strip.material.thickness,time.frames,level,level_status,"
-            "iterations,final_residual,wall_seconds,checkpoint,error");
+            "iterations,final_residual,static_residual,wall_seconds,checkpoint,error");
   int rows = 0;
   for (; std::getline(lines, row); ++rows) {
     EXPECT_NE(row.find(",done,1,"), std::string::npos) << row;
@@ -59,9 +59,18 @@ TEST_F(ResultsCommand, JsonHasTheResidualHistories) {
     EXPECT_EQ(job["state"], "done");
     ASSERT_EQ(job["levels"].size(), 1u);
     const auto& residuals = job["levels"][0]["residuals"];
-    // One residual per Newton step, plus the converged check that ends each of the 2 frames.
-    EXPECT_EQ(residuals.size(), job["levels"][0]["iterations"].get<std::size_t>() + 2);
+    // One residual per Newton step, plus the converged check that ends each solve: at least the
+    // frame's own in each of the 2 frames, then those of its settling steps.
+    EXPECT_GT(residuals.size(), job["levels"][0]["iterations"].get<std::size_t>() + 2);
     for (const auto& r : residuals) EXPECT_GE(r.get<double>(), 0.0);
+    // Both frames settled to equilibrium, each with its static residual.
+    const auto& settled = job["levels"][0]["static_residuals"];
+    ASSERT_EQ(settled.size(), 2u);
+    for (int f = 0; f < 2; ++f) {
+      EXPECT_EQ(settled[f][0].get<int>(), f + 1);
+      EXPECT_GE(settled[f][1].get<double>(), 0.0);
+    }
+    EXPECT_EQ(job["levels"][0]["static_residual"], settled[1][1]);
   }
 }
 
