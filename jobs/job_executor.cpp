@@ -251,6 +251,11 @@ class JobRun {
           solver_->step([this](int frame, const NewtonIteration& it) { on_iteration(frame, it); });
       resumed_in_frame_.reset();
       frame_energy_ = frame.elastic_energy;
+      if (frame.must_converge && frame.stagnated)
+        throw NotConverged(fmt::format(
+            "level {} frame {} stagnated at round-off at ‖Δx‖∞/Δt = {:.3e}: solver.tolerance is "
+            "finer than double precision resolves for this scene; raise it above that",
+            frame.level, frame.frame, frame.step_norm));
       if (frame.must_converge && !frame.converged)
         throw NotConverged(fmt::format(
             "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "

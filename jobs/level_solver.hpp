@@ -18,6 +18,8 @@ struct LevelFrame {
   int level = 0;
   int frame = 0;           ///< 1-based; frame 0 is the rest state
   bool converged = false;  ///< met the level's tolerance
+  /// Stopped unconverged at round-off: the tolerance is finer than double precision resolves.
+  bool stagnated = false;
   /// Whether the frame had to converge; a preview level's frame may stop at its budget.
   bool must_converge = true;
   int iterations = 0;           ///< Newton iterations of the frame, including any before a restore

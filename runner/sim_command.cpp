@@ -84,6 +84,15 @@ void show_iteration(const std::string& where, const NewtonIteration& it) {
             << std::flush;
 }
 
+/// "converged", or why not.
+std::string verdict(const NewtonResult& newton) {
+  if (newton.converged) return "converged";
+  if (newton.stagnated)
+    return "NOT converged: stagnated at round-off (the tolerance is finer than double precision "
+           "resolves here; raise [solver] tolerance above the ‖Δx‖∞/Δt reached)";
+  return "NOT converged";
+}
+
 /// The summary fields of every run; the progressive one adds its levels.
 nlohmann::json run_summary(const Scene& scene, const TriMesh& rest, double tolerance,
                            int level_count, bool all_converged, const nlohmann::json& frames) {
@@ -147,7 +156,7 @@ int run_direct(const Scene& scene, const SimOptions& sim_options) {
     std::cerr << fmt::format(
         "{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}{}, {:.3f} s\n", terminal ? "\r" : "",
         record.frame, sim.frame_count(), record.newton.iterations,
-        record.newton.converged ? "converged" : "NOT converged", record.newton.step_norm,
+        verdict(record.newton), record.newton.step_norm,
         record.settle_steps > 0 ? fmt::format(", {} settling steps, static residual {:.3e}",
                                               record.settle_steps, record.static_residual)
                                 : "",
@@ -198,7 +207,7 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
           "{}  level {}/{} frame {}/{}{}: {} iterations, {}, change {:.3e} m/s, {:.3f} s\n",
           terminal ? "\r" : "", step.level, sim.level_count() - 1, step.frame.frame,
           sim.frame_count(), step.settling ? " (settling)" : "", step.frame.newton.iterations,
-          step.frame.newton.converged ? "converged" : "NOT converged", step.change,
+          verdict(step.frame.newton), step.change,
           step.frame.newton.wall_seconds);
     }
     if (sim.level_count() > 1) level.converged = level.converged && sim.level_converged();

@@ -40,6 +40,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
   return {{"frame", r.frame},
           {"time", r.time},
           {"converged", r.newton.converged},
+          {"stagnated", r.newton.stagnated},
           {"iterations", r.newton.iterations},
           {"energy", r.newton.energy},
           {"elastic_energy", r.elastic_energy},

@@ -164,7 +164,7 @@ NewtonResult QuasistaticSimulation::solve_in_chunks(const DofMap& dofs,
     NewtonResult part = newton_.minimize(potential_, x_, dofs, chunk, numbered);
     done += part.iterations;
     append_solve(total, std::move(part));
-    if (total.converged || done >= settings.max_iterations) return total;
+    if (total.converged || total.stagnated || done >= settings.max_iterations) return total;
     update_stiffnesses();
   }
 }

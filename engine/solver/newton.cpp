@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -32,6 +33,34 @@ constexpr double kExtrapolationFloor = 1e-9;
 /// Energy changes smaller than this fraction of |E| are below the rounding of E itself, so
 /// the Armijo test does not reject a step for them (it would stall a converging solve).
 constexpr double kEnergyRoundoff = 1e-12;
+
+/// Watches a solve for stagnation at round-off (NewtonResult::stagnated): the step norm stops
+/// falling while the energy changes only by its rounding. A slow solve that still lowers E
+/// (backtracking through a fold, contact) is not stagnating, however long its step norms wander.
+class RoundoffStagnation {
+ public:
+  /// Iterations without the step norm halving before a solve that did not lower E beyond its
+  /// rounding meanwhile has stagnated.
+  static constexpr int kWindow = 10;
+
+  /// Takes an iteration's step norm and its starting energy; true once stagnated.
+  bool stagnated(double step_norm, double energy) {
+    if (step_norm < 0.5 * best_step_norm_) {
+      best_step_norm_ = step_norm;
+      energy_at_best_ = energy;
+      iterations_since_best_ = 0;
+      return false;
+    }
+    ++iterations_since_best_;
+    return iterations_since_best_ >= kWindow &&
+           energy_at_best_ - energy <= kWindow * kEnergyRoundoff * std::abs(energy);
+  }
+
+ private:
+  double best_step_norm_ = std::numeric_limits<double>::infinity();
+  double energy_at_best_ = 0.0;
+  int iterations_since_best_ = 0;
+};
 
 void check_settings(const NewtonSettings& s) {
   const auto require = [](bool ok, const char* name, double value, const char* range) {
@@ -101,6 +130,7 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
 
   Eigen::VectorXd gradient;
   Eigen::VectorXd free_gradient;
+  RoundoffStagnation stagnation;
   for (int k = 0;; ++k) {
     record.iteration = k;
     record.energy = energy;
@@ -119,14 +149,15 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     // A gradient fallback step says nothing about the distance to the minimum.
     result.converged =
         record.direction != DirectionKind::gradient && record.step_norm < settings.tolerance;
-    if (!result.converged && k < settings.max_iterations)
+    result.stagnated = !result.converged && stagnation.stagnated(record.step_norm, energy);
+    if (!result.converged && !result.stagnated && k < settings.max_iterations)
       energy = line_search(objective, x, direction, energy, free_gradient.dot(free_direction),
                            settings, record);
 
     result.history.push_back(record);
     result.times += record.times;
     if (progress) progress(record);
-    if (result.converged || k == settings.max_iterations) break;
+    if (result.converged || result.stagnated || k == settings.max_iterations) break;
     if (k + 1 == settings.max_iterations && !settings.judge_final_iterate) break;
     record = NewtonIteration{};
   }

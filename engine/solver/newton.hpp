@@ -36,7 +36,8 @@ struct NewtonSettings {
 /// the negative gradient, as fallbacks when K is not positive definite or d is not a descent
 /// direction), first trial step α = min(1, max_feasible_step(x, d)), Armijo backtracking; a
 /// full step that lowers E far more than the quadratic model predicts is extended (α = 2, 4, …)
-/// while E keeps decreasing and the CCD allows the motion.
+/// while E keeps decreasing and the CCD allows the motion. A solve that stagnates at round-off
+/// (NewtonResult::stagnated) stops instead of spending its remaining iterations.
 class NewtonSolver {
  public:
   using Progress = std::function<void(const NewtonIteration&)>;

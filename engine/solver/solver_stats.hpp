@@ -54,6 +54,11 @@ struct NewtonIteration {
 /// taken without meeting the tolerance; the caller decides what that means.
 struct NewtonResult {
   bool converged = false;
+  /// Stopped before converging because the solve stagnated at round-off: for
+  /// kStagnationWindow iterations the step norm did not halve while E decreased by no more than
+  /// its rounding. The tolerance is then finer than double precision resolves for this problem,
+  /// and step_norm is the accuracy reached.
+  bool stagnated = false;
   /// Steps taken: history.size() − 1, or history.size() when the final iterate was not judged
   /// (NewtonSettings::judge_final_iterate): then the last record is the last step's.
   int iterations = 0;

@@ -569,6 +569,63 @@ TEST(Newton, NegativeDefiniteHessianFallsBackToGradient) {
   EXPECT_EQ(x, Eigen::VectorXd::Zero(3));
 }
 
+/// A separable quadratic ½ Σ (xᵢ − 1)² carried on a large energy offset, whose gradient holds a
+/// deterministic error of relative size `noise` (as a gradient summed from large cancelling
+/// element forces does): Newton gets within about `noise` of the minimum and then only moves in
+/// the error, with energy changes far below the rounding of E.
+class NoisyQuadratic : public Objective {
+ public:
+  NoisyQuadratic(int vertices, double noise) : n_(3 * vertices), noise_(noise) {}
+  [[nodiscard]] Eigen::Index size() const override { return n_; }
+  double value(const Eigen::VectorXd& x) override {
+    return kOffset + 0.5 * (x.array() - 1.0).square().sum();
+  }
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+    ++evaluations_;
+    g = x.array() - 1.0;
+    for (Eigen::Index i = 0; i < n_; ++i)
+      g[i] += noise_ * std::sin(1e3 * static_cast<double>(evaluations_ * n_ + i));
+  }
+  void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+    h.diagonal = Eigen::VectorXd::Ones(n_);
+    h.batches.clear();
+  }
+
+ private:
+  static constexpr double kOffset = 1e6;
+  Eigen::Index n_;
+  double noise_;
+  long evaluations_ = 0;
+};
+
+TEST(Newton, StagnationAtRoundoffStopsAndSaysSo) {
+  NoisyQuadratic objective(4, 1e-9);
+  NewtonSettings settings;
+  settings.tolerance = 1e-12;  // below the gradient's error: unreachable
+  settings.max_iterations = 400;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(objective.size());
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(4, {}), settings);
+  EXPECT_FALSE(result.converged);
+  EXPECT_TRUE(result.stagnated);
+  EXPECT_LT(result.iterations, 30);  // not the 400 allowed
+  // The accuracy reached is the gradient error's, and the iterate is that close to the minimum.
+  EXPECT_LT(result.step_norm, 1e-8);
+  EXPECT_GT(result.step_norm, settings.tolerance);
+  EXPECT_LT((x.array() - 1.0).abs().maxCoeff(), 1e-8);
+}
+
+TEST(Newton, AReachableToleranceIsNotStagnation) {
+  NoisyQuadratic objective(4, 1e-9);
+  NewtonSettings settings;
+  settings.tolerance = 1e-7;  // above the gradient's error
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(objective.size());
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(4, {}), settings);
+  EXPECT_TRUE(result.converged);
+  EXPECT_FALSE(result.stagnated);
+}
+
 TEST(Newton, RejectsBadSettings) {
   ProbeQuadratic probe(3, 1.0);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
