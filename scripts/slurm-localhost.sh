@@ -39,6 +39,7 @@ real_memory_mb() {
   echo $((total > 1024 ? total - 512 : total))
 }
 
+# Writes slurm.conf; false when it was already so (running daemons then need no restart).
 write_config() {
   mkdir -p "$conf_dir" "$state_dir/ctld" "$state_dir/spool" "$log_dir" "$run_dir"
   local tmp="$conf_dir/.slurm.conf.tmp$$"
@@ -79,6 +80,10 @@ DefMemPerCPU=$(($(real_memory_mb) / $(nproc)))
 NodeName=localhost CPUs=$(nproc) RealMemory=$(real_memory_mb) State=UNKNOWN
 PartitionName=debug Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
+  if cmp -s "$tmp" "$conf_dir/slurm.conf"; then
+    rm -f "$tmp"
+    return 1
+  fi
   mv "$tmp" "$conf_dir/slurm.conf"
 }
 
@@ -129,7 +134,11 @@ case "${1:-}" in
   start)
     require_root
     install_packages
-    write_config
+    if write_config; then
+      # A changed configuration (another machine size, a new psq): the daemons reread it.
+      stop_daemon "$run_dir/slurmd.pid"
+      stop_daemon "$run_dir/slurmctld.pid"
+    fi
     start_munge
     start_slurm
     wait_ready
