@@ -213,6 +213,19 @@ std::string task_log(const fs::path& manifest, const HeldJob& held) {
   return (manifest.parent_path() / fmt::format("task-{}.log", held.task())).string();
 }
 
+/// Whether the job's directory holds a checkpoint written since `since` (Unix seconds).
+bool checkpointed_since(const fs::path& run, double since) {
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(run, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with("level_") || entry.path().extension() != ".h5") continue;
+    const auto written = std::chrono::file_clock::to_sys(entry.last_write_time(error));
+    if (!error && std::chrono::duration<double>(written.time_since_epoch()).count() >= since)
+      return true;
+  }
+  return false;
+}
+
 /// What one sync did, for its summary line.
 struct SyncCounts {
   std::map<std::string, int> on_cluster;  ///< by SLURM state
@@ -223,11 +236,14 @@ struct SyncCounts {
 
 /// Brings one held job's outcome into the store; returns the task row to record.
 slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJob& held,
-                          const std::optional<slurm::TaskState>& seen, const fs::path& manifest,
-                          SyncCounts& counts) {
+                          const std::optional<slurm::TaskState>& seen,
+                          const std::optional<slurm::SlurmTask>& known, SyncCounts& counts) {
+  const fs::path manifest = known ? known->manifest : "";
+  // A row lost to a crash between claim and record (submit) is rebuilt from the lease owner.
   slurm::SlurmTask row{held.job.id, held.job.attempt, held.array_id, held.index,
                        manifest.string(), seen ? seen->state : "UNKNOWN",
-                       seen ? seen->reason : "", unix_now(), unix_now()};
+                       seen ? seen->reason : "", known ? known->submitted_at : unix_now(),
+                       unix_now()};
   std::optional<TaskResult> result = slurm::read_task_result(slurm::task_result(runs, held.job.id));
   // A result file of an earlier submission of the job says nothing about this one.
   if (result && (result->array_id != held.array_id || result->index != held.index))
@@ -271,6 +287,15 @@ slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJ
       "checkpoint (scancel --signal=KILL, out of memory, node failure) or failed to start; "
       "its log is {}; psq slurm submit runs it again from its last checkpoint",
       held.task(), scheduler_word, task_log(manifest, held));
+  // An attempt that made progress does not count against the retry bound (DESIGN.md §9): a
+  // job that advances through kills always finishes.
+  if (checkpointed_since(runs / held.job.id, row.submitted_at)) {
+    store.release(held.lease());
+    row.reason = "killed after progress";
+    ++counts.requeued;
+    say(message + " (it made progress: no failure counted)");
+    return row;
+  }
   store.finish(held.lease(), db::Outcome::failed, message);
   const std::optional<db::Job> now = store.find_job(held.job.id);
   if (now && now->state == db::JobState::queued)
@@ -297,17 +322,18 @@ int run_sync(const SyncOptions& options) {
   slurm::Scheduler scheduler;
   const std::map<std::string, slurm::TaskState> states =
       scheduler.states({arrays.begin(), arrays.end()});
-  std::map<std::pair<std::string, std::int64_t>, std::string> manifests;
-  for (const slurm::SlurmTask& t : slurm::SlurmTaskTable(database).holding(options.sweep))
-    manifests[{t.job_id, t.attempt}] = t.manifest;
+  std::map<std::pair<std::string, std::int64_t>, slurm::SlurmTask> known;
+  for (slurm::SlurmTask& t : slurm::SlurmTaskTable(database).holding(options.sweep))
+    known.emplace(std::pair{t.job_id, t.attempt}, std::move(t));
   SyncCounts counts;
   std::vector<slurm::SlurmTask> rows;
   for (const HeldJob& h : held) {
     const auto seen = states.find(h.task());
-    rows.push_back(sync_job(store, runs_directory(database), h,
-                            seen == states.end() ? std::nullopt
-                                                 : std::optional(seen->second),
-                            manifests[{h.job.id, h.job.attempt}], counts));
+    const auto row = known.find({h.job.id, h.job.attempt});
+    rows.push_back(sync_job(
+        store, runs_directory(database), h,
+        seen == states.end() ? std::nullopt : std::optional(seen->second),
+        row == known.end() ? std::nullopt : std::optional(row->second), counts));
   }
   slurm::SlurmTaskTable(database).record(rows);
   std::string cluster;
