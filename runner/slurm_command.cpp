@@ -306,6 +306,26 @@ slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJ
   return row;
 }
 
+/// `psq cancel` ends a job's claim in the store; the cluster learns it here: its task, if
+/// still live, is cancelled (it checkpoints on the SIGTERM, so psq retry can continue it).
+void cancel_tasks_of_cancelled_jobs(slurm::Scheduler& scheduler, slurm::SlurmTaskTable& table,
+                                    const std::string& sweep,
+                                    const std::map<std::string, slurm::TaskState>& states,
+                                    std::vector<slurm::SlurmTask>& rows) {
+  for (slurm::SlurmTask& task : table.cancelled(sweep)) {
+    const std::string name = slurm::task_name(task.array_id, task.index);
+    const auto seen = states.find(name);
+    if (seen == states.end() || !slurm::is_live(seen->second.state)) continue;
+    scheduler.cancel(name);
+    std::cout << fmt::format("job {} (task {}): cancelled in the store; task cancelled\n",
+                             task.job_id, name);
+    task.state = "CANCELLED";
+    task.reason = "psq cancel";
+    task.synced_at = unix_now();
+    rows.push_back(std::move(task));
+  }
+}
+
 int run_sync(const SyncOptions& options) {
   const fs::path database = database_path(options.database);
   require_database(database);
@@ -314,16 +334,19 @@ int run_sync(const SyncOptions& options) {
                                          ? db::JobSelection::all()
                                          : db::JobSelection::sweep(options.sweep);
   if (!options.sweep.empty()) store.status(options.sweep);  // unknown sweep: its message
+  slurm::SlurmTaskTable table(database);
   const std::vector<HeldJob> held = held_jobs(store, selection);
   std::set<std::string> arrays;
   for (const HeldJob& h : held) arrays.insert(h.array_id);
+  for (const slurm::SlurmTask& t : table.cancelled(options.sweep))
+    if (slurm::is_live(t.state)) arrays.insert(t.array_id);
   // The scheduler first, the result files second: a task writes its result before it ends,
   // so a task seen ended without a result file has none.
   slurm::Scheduler scheduler;
   const std::map<std::string, slurm::TaskState> states =
       scheduler.states({arrays.begin(), arrays.end()});
   std::map<std::pair<std::string, std::int64_t>, slurm::SlurmTask> known;
-  for (slurm::SlurmTask& t : slurm::SlurmTaskTable(database).holding(options.sweep))
+  for (slurm::SlurmTask& t : table.holding(options.sweep))
     known.emplace(std::pair{t.job_id, t.attempt}, std::move(t));
   SyncCounts counts;
   std::vector<slurm::SlurmTask> rows;
@@ -335,7 +358,8 @@ int run_sync(const SyncOptions& options) {
         seen == states.end() ? std::nullopt : std::optional(seen->second),
         row == known.end() ? std::nullopt : std::optional(row->second), counts));
   }
-  slurm::SlurmTaskTable(database).record(rows);
+  cancel_tasks_of_cancelled_jobs(scheduler, table, options.sweep, states, rows);
+  table.record(rows);
   std::string cluster;
   for (const auto& [state, n] : counts.on_cluster)
     cluster += fmt::format(", {} {}", n, state);

@@ -47,14 +47,24 @@ void SlurmTaskTable::record(const std::vector<SlurmTask>& tasks) {
 }
 
 std::vector<SlurmTask> SlurmTaskTable::holding(const std::string& sweep) {
+  return select("running", sweep);
+}
+
+std::vector<SlurmTask> SlurmTaskTable::cancelled(const std::string& sweep) {
+  return select("cancelled", sweep);
+}
+
+std::vector<SlurmTask> SlurmTaskTable::select(const std::string& job_state,
+                                              const std::string& sweep) {
+  // Cancelling leaves the attempt as it was, so a cancelled job's last claim is still known.
   auto query = connection_.prepare(
       "SELECT t.job_id, t.attempt, t.array_id, t.task_index, t.manifest, t.state, t.reason, "
       "t.submitted_at, t.synced_at FROM slurm_tasks t JOIN jobs j ON j.id = t.job_id "
-      "WHERE j.state = 'running' AND j.attempt = t.attempt AND (?1 = '' OR EXISTS ("
+      "WHERE j.state = ?2 AND j.attempt = t.attempt AND (?1 = '' OR EXISTS ("
       "SELECT 1 FROM sweep_jobs sj JOIN sweeps s ON s.id = sj.sweep_id "
       "WHERE sj.job_id = t.job_id AND s.name = ?1)) "
       "ORDER BY CAST(t.array_id AS INTEGER), t.task_index");
-  query.bind_all(sweep);
+  query.bind_all(sweep, job_state);
   std::vector<SlurmTask> tasks;
   while (query.step())
     tasks.push_back({query.text(0), query.integer(1), query.text(2),

@@ -43,8 +43,13 @@ class SlurmTaskTable {
   /// The tasks of the sweep (every sweep when empty) that hold their job now: the job is
   /// running with the task's attempt. By array, then index.
   std::vector<SlurmTask> holding(const std::string& sweep);
+  /// The tasks of the sweep (every sweep when empty) whose job was cancelled in the store
+  /// (psq cancel) while they held it.
+  std::vector<SlurmTask> cancelled(const std::string& sweep);
 
  private:
+  std::vector<SlurmTask> select(const std::string& job_state, const std::string& sweep);
+
   db::SqliteConnection connection_;
 };
 

@@ -231,6 +231,28 @@ TEST(Slurm, RequeuedKilledAndTimedOutTasksResumeAndSyncToTheLocalResult) {
   expect_equal_to_local_run(sweep, local);
 }
 
+TEST(Slurm, SyncCancelsTheTasksOfJobsCancelledInTheStore) {
+  require_cluster();
+  const SlurmSweep sweep("slurm_cancel");
+  const test::ProcessResult submit = sweep.psq({"slurm", "submit", "k", "--max-parallel", "1"});
+  ASSERT_EQ(submit.exit_code, 0) << submit.errors;
+  const std::string array = submitted_array(submit);
+  ASSERT_EQ(sweep.psq({"cancel", "k"}).exit_code, 0);
+  const test::ProcessResult sync = sweep.psq({"slurm", "sync", "k"});
+  ASSERT_EQ(sync.exit_code, 0) << sync.errors;
+  EXPECT_EQ(count(sync.output, "cancelled in the store; task cancelled"), 4u) << sync.output;
+  wait_until(
+      [&] {
+        for (const auto& [name, seen] : task_states(array))
+          if (seen.state != "CANCELLED") return false;
+        return true;
+      },
+      30, "the tasks to be cancelled", array);
+  for (const db::JobResult& r : sweep.results()) EXPECT_EQ(r.job.state, db::JobState::cancelled);
+  // Once cancelled, a task is not cancelled again.
+  EXPECT_EQ(count(sweep.psq({"slurm", "sync", "k"}).output, "task cancelled"), 0u);
+}
+
 /// The store's jobs as text, and whether a submission left files behind.
 std::string store_snapshot(const SlurmSweep& sweep) {
   std::string text;
