@@ -161,7 +161,12 @@ int run_submit(const SubmitOptions& options) {
   slurm::Scheduler scheduler;
   std::string array_id;
   try {
-    fs::create_directories(submission);
+    std::error_code error;
+    fs::create_directories(submission, error);
+    if (error)
+      throw InputError(fmt::format("cannot create the submission directory {}: {}; make the "
+                                   "store's directory writable",
+                                   submission.string(), error.message()));
     slurm::write_manifest(manifest_file, manifest);
     const std::string script = array_script(options, submission, manifest_file,
                                             manifest.jobs.size());

@@ -25,14 +25,14 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-/// The sweep: four cantilevers of 40 frames (a few seconds each).
+/// The sweep: four cantilevers of 200 frames (5-10 s each, long enough to act mid-level).
 struct SlurmSweep : test::CantileverWorkspace {
   explicit SlurmSweep(const std::string& name) : CantileverWorkspace(name) {
     const test::ProcessResult added =
         add_sweep("k",
                   "\"shell.strip.material.thickness\" = [5e-4, 6e-4, 7e-4, 8e-4]\n"
                   "\"shell.strip.material.youngs_modulus\" = [5e6]\n"
-                  "\"time.frames\" = [40]\n");
+                  "\"time.frames\" = [200]\n");
     EXPECT_EQ(added.exit_code, 0) << added.errors;
   }
   Checkpoint final_checkpoint(const std::string& job) const {
@@ -74,11 +74,22 @@ bool is_live(const std::string& state) {
          state == "REQUEUED" || state == "CONFIGURING";
 }
 
-/// A requeued task waits two minutes (SLURM's requeue delay); an administrator may start it now.
+/// A requeued task waits two minutes (SLURM's requeue delay); an administrator may start it
+/// sooner, but not within the second of the requeue: slurmd refuses a launch whose credential
+/// is no newer than the revoked one of the killed instance ("Job credential revoked").
 void start_requeued_now(const std::string& array_id) {
-  for (const auto& [task, seen] : task_states(array_id))
-    if (seen.state == "PENDING" && seen.reason == "BeginTime")
+  static std::map<std::string, Clock::time_point> first_seen;
+  for (const auto& [task, seen] : task_states(array_id)) {
+    if (seen.state != "PENDING" || seen.reason != "BeginTime") {
+      first_seen.erase(task);
+      continue;
+    }
+    const auto [at, added] = first_seen.emplace(task, Clock::now());
+    if (Clock::now() - at->second > std::chrono::seconds(3)) {
       run("/usr/bin/scontrol", {"update", "JobId=" + task, "StartTime=now"});
+      first_seen.erase(at);
+    }
+  }
 }
 
 void wait_until(const std::function<bool()>& done, double seconds, const std::string& what,
