@@ -44,8 +44,7 @@ constexpr double kClusterLeaseSeconds = 365.0 * 24 * 3600;
 constexpr double kTaskLeaseSeconds = 3.0;
 
 double unix_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 std::string environment(const char* name) {
@@ -70,8 +69,8 @@ struct SubmitOptions {
 /// A value for an #SBATCH line, which sbatch splits at white space.
 const std::string& sbatch_value(const std::string& option, const std::string& value) {
   if (value.find_first_of(" \t\r\n\"'") != std::string::npos)
-    throw InputError(fmt::format("--{} '{}': spaces and quotes cannot go into an sbatch option",
-                                 option, value));
+    throw InputError(
+        fmt::format("--{} '{}': spaces and quotes cannot go into an sbatch option", option, value));
   return value;
 }
 
@@ -128,16 +127,17 @@ std::vector<slurm::SlurmTask> claim_for_tasks(db::JobStore& store, slurm::Schedu
     const int index = static_cast<int>(i);
     const db::WorkerInfo owner{slurm::slurm_owner(array_id, index),
                                fmt::format("slurm array {}", array_id), PSQ_VERSION};
-    const std::optional<db::Claim> claim = store.claim_next(
-        owner, kClusterLeaseSeconds, db::JobSelection::job(manifest.jobs[i].id));
+    const std::optional<db::Claim> claim =
+        store.claim_next(owner, kClusterLeaseSeconds, db::JobSelection::job(manifest.jobs[i].id));
     if (!claim) {
       scheduler.cancel(slurm::task_name(array_id, index));
-      std::cerr << fmt::format("psq slurm submit: job {} was claimed meanwhile; task {} cancelled\n",
-                               manifest.jobs[i].id, slurm::task_name(array_id, index));
+      std::cerr << fmt::format(
+          "psq slurm submit: job {} was claimed meanwhile; task {} cancelled\n",
+          manifest.jobs[i].id, slurm::task_name(array_id, index));
       continue;
     }
-    tasks.push_back({claim->job.id, claim->lease.attempt, array_id, index, file.string(),
-                     "PENDING", "", unix_now(), std::nullopt});
+    tasks.push_back({claim->job.id, claim->lease.attempt, array_id, index, file.string(), "PENDING",
+                     "", unix_now(), std::nullopt});
   }
   return tasks;
 }
@@ -164,12 +164,13 @@ int run_submit(const SubmitOptions& options) {
     std::error_code error;
     fs::create_directories(submission, error);
     if (error)
-      throw InputError(fmt::format("cannot create the submission directory {}: {}; make the "
-                                   "store's directory writable",
-                                   submission.string(), error.message()));
+      throw InputError(
+          fmt::format("cannot create the submission directory {}: {}; make the "
+                      "store's directory writable",
+                      submission.string(), error.message()));
     slurm::write_manifest(manifest_file, manifest);
-    const std::string script = array_script(options, submission, manifest_file,
-                                            manifest.jobs.size());
+    const std::string script =
+        array_script(options, submission, manifest_file, manifest.jobs.size());
     write_file_atomically(script_file, [&](std::ostream& out) { out << script; });
     array_id = scheduler.submit(script_file);
   } catch (...) {
@@ -245,14 +246,18 @@ slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJ
                           const std::optional<slurm::SlurmTask>& known, SyncCounts& counts) {
   const fs::path manifest = known ? known->manifest : "";
   // A row lost to a crash between claim and record (submit) is rebuilt from the lease owner.
-  slurm::SlurmTask row{held.job.id, held.job.attempt, held.array_id, held.index,
-                       manifest.string(), seen ? seen->state : "UNKNOWN",
-                       seen ? seen->reason : "", known ? known->submitted_at : unix_now(),
+  slurm::SlurmTask row{held.job.id,
+                       held.job.attempt,
+                       held.array_id,
+                       held.index,
+                       manifest.string(),
+                       seen ? seen->state : "UNKNOWN",
+                       seen ? seen->reason : "",
+                       known ? known->submitted_at : unix_now(),
                        unix_now()};
   std::optional<TaskResult> result = slurm::read_task_result(slurm::task_result(runs, held.job.id));
   // A result file of an earlier submission of the job says nothing about this one.
-  if (result && (result->array_id != held.array_id || result->index != held.index))
-    result.reset();
+  if (result && (result->array_id != held.array_id || result->index != held.index)) result.reset();
   const auto say = [&](const std::string& what) {
     std::cout << fmt::format("job {} (task {}): {}\n", held.job.id, held.task(), what);
   };
@@ -282,7 +287,8 @@ slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJ
     store.release(held.lease());
     row.reason = "stopped after a checkpoint";
     ++counts.requeued;
-    say(fmt::format("stopped by the scheduler ({}) after writing a checkpoint; queued again, "
+    say(
+        fmt::format("stopped by the scheduler ({}) after writing a checkpoint; queued again, "
                     "psq slurm submit continues it from there",
                     scheduler_word));
     return row;
@@ -335,9 +341,8 @@ int run_sync(const SyncOptions& options) {
   const fs::path database = database_path(options.database);
   require_database(database);
   db::JobStore store(database);
-  const db::JobSelection selection = options.sweep.empty()
-                                         ? db::JobSelection::all()
-                                         : db::JobSelection::sweep(options.sweep);
+  const db::JobSelection selection =
+      options.sweep.empty() ? db::JobSelection::all() : db::JobSelection::sweep(options.sweep);
   if (!options.sweep.empty()) store.status(options.sweep);  // unknown sweep: its message
   slurm::SlurmTaskTable table(database);
   const std::vector<HeldJob> held = held_jobs(store, selection);
@@ -358,16 +363,15 @@ int run_sync(const SyncOptions& options) {
   for (const HeldJob& h : held) {
     const auto seen = states.find(h.task());
     const auto row = known.find({h.job.id, h.job.attempt});
-    rows.push_back(sync_job(
-        store, runs_directory(database), h,
-        seen == states.end() ? std::nullopt : std::optional(seen->second),
-        row == known.end() ? std::nullopt : std::optional(row->second), counts));
+    rows.push_back(sync_job(store, runs_directory(database), h,
+                            seen == states.end() ? std::nullopt : std::optional(seen->second),
+                            row == known.end() ? std::nullopt : std::optional(row->second),
+                            counts));
   }
   cancel_tasks_of_cancelled_jobs(scheduler, table, options.sweep, states, rows);
   table.record(rows);
   std::string cluster;
-  for (const auto& [state, n] : counts.on_cluster)
-    cluster += fmt::format(", {} {}", n, state);
+  for (const auto& [state, n] : counts.on_cluster) cluster += fmt::format(", {} {}", n, state);
   std::cout << fmt::format("psq slurm sync: {} done, {} failed, {} queued again{}\n", counts.done,
                            counts.failed, counts.requeued,
                            cluster.empty() ? ", none left on the cluster" : cluster);
@@ -427,7 +431,8 @@ int run_task(const TaskOptions& options) {
   settings.snapshot_iterations = manifest.snapshot_iterations;
   settings.snapshot_seconds = manifest.snapshot_seconds;
   const int code = work_in_this_process(
-      settings, {store_file, manifest.runs, slurm::task_directory(manifest.runs, job.id) / "cache"});
+      settings,
+      {store_file, manifest.runs, slurm::task_directory(manifest.runs, job.id) / "cache"});
   slurm::write_task_result(slurm::task_result(manifest.runs, job.id),
                            task_outcome(store_file, job.id, options.index));
   const std::string slurm_job = environment("SLURM_JOB_ID");

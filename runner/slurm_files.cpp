@@ -141,7 +141,8 @@ std::optional<TaskResult> read_task_result(const fs::path& file) {
     result.index = value.at("index").get<int>();
     result.state = db::job_state_from_string(value.at("state").get<std::string>());
     result.error = value.at("error").get<std::string>();
-    for (const nlohmann::json& level : value.at("levels")) result.levels.push_back(level_from(level));
+    for (const nlohmann::json& level : value.at("levels"))
+      result.levels.push_back(level_from(level));
     return result;
   } catch (const std::exception& error) {
     throw InputError(

@@ -58,9 +58,9 @@ std::string submission_hint(const std::string& errors) {
 }  // namespace
 
 bool is_live(const std::string& state) {
-  static constexpr std::array kLive{"PENDING",   "RUNNING",  "REQUEUED",   "REQUEUE_FED",
-                                    "REQUEUE_HOLD", "RESIZING", "SUSPENDED", "CONFIGURING",
-                                    "COMPLETING", "SIGNALING", "STAGE_OUT",  "RESV_DEL_HOLD",
+  static constexpr std::array kLive{"PENDING",      "RUNNING",   "REQUEUED",  "REQUEUE_FED",
+                                    "REQUEUE_HOLD", "RESIZING",  "SUSPENDED", "CONFIGURING",
+                                    "COMPLETING",   "SIGNALING", "STAGE_OUT", "RESV_DEL_HOLD",
                                     "STOPPED"};
   for (const char* live : kLive)
     if (state == live) return true;
@@ -112,8 +112,8 @@ std::map<std::string, TaskState> Scheduler::states(const std::vector<std::string
   const std::string jobs = fmt::format("{}", fmt::join(array_ids, ","));
   // Ended arrays whose every task left the controller's memory make squeue fail with "Invalid
   // job id"; sacct then answers for them.
-  const Output queue = run("squeue", {"--noheader", "--array", "--states=all",
-                                      "--jobs=" + jobs, "--format=%i|%T|%r"});
+  const Output queue = run(
+      "squeue", {"--noheader", "--array", "--states=all", "--jobs=" + jobs, "--format=%i|%T|%r"});
   if (queue.status != 0 && queue.errors.find("Invalid job id") == std::string::npos)
     throw InputError(fmt::format(
         "squeue cannot tell the state of the array jobs {}: {}; check `scontrol ping` and "
@@ -123,9 +123,8 @@ std::map<std::string, TaskState> Scheduler::states(const std::vector<std::string
     const std::vector<std::string> fields = split(trimmed(line), '|');
     if (fields.size() >= 3) states[fields[0]] = {fields[1], fields[2] == "None" ? "" : fields[2]};
   }
-  const Output accounting =
-      run("sacct", {"--noheader", "--parsable2", "--allocations", "--jobs=" + jobs,
-                    "--format=JobID,State,ExitCode"});
+  const Output accounting = run("sacct", {"--noheader", "--parsable2", "--allocations",
+                                          "--jobs=" + jobs, "--format=JobID,State,ExitCode"});
   if (accounting.status != 0) return states;  // no accounting on this cluster: squeue's word
   for (const std::string& line : split(accounting.out, '\n')) {
     const std::vector<std::string> fields = split(trimmed(line), '|');

@@ -86,8 +86,8 @@ int work_in_this_process(const WorkSettings& settings, const WorkerPlacement& pl
   const auto make_solver = [cache = placement.cache](const Scene& scene, int depth) {
     return jobs::make_level_solver(scene, depth, cache);
   };
-  const jobs::WorkerSummary summary = jobs::run_worker(placement.database, placement.runs,
-                                                       make_solver, options, events, stop_requested);
+  const jobs::WorkerSummary summary = jobs::run_worker(
+      placement.database, placement.runs, make_solver, options, events, stop_requested);
   display.clear();
   if (!supervised)
     display.log(fmt::format("psq work: {} done, {} failed{}{}", summary.done, summary.failed,

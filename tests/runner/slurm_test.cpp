@@ -47,8 +47,7 @@ test::ProcessResult run(const std::string& program, const std::vector<std::strin
 bool node_ready() {
   const std::string state =
       run("/usr/bin/sinfo", {"--noheader", "--nodes=localhost", "--format=%T"}).output;
-  return state.starts_with("idle") || state.starts_with("mixed") ||
-         state.starts_with("allocated");
+  return state.starts_with("idle") || state.starts_with("mixed") || state.starts_with("allocated");
 }
 
 /// Uses the localhost cluster, starting it (as root) if its node is not ready. Never skips: a
@@ -57,9 +56,9 @@ void require_cluster() {
   if (node_ready()) return;
   const test::ProcessResult started =
       run((test::source_dir() / "scripts/slurm-localhost.sh").string(), {"start"});
-  ASSERT_EQ(started.exit_code, 0)
-      << "the localhost SLURM cluster did not start (run as root; see scripts/slurm-localhost.sh):\n"
-      << started.output << started.errors;
+  ASSERT_EQ(started.exit_code, 0) << "the localhost SLURM cluster did not start (run as root; see "
+                                     "scripts/slurm-localhost.sh):\n"
+                                  << started.output << started.errors;
   ASSERT_TRUE(node_ready());
 }
 
@@ -80,8 +79,8 @@ std::map<std::string, Seen> task_states(const std::string& array_id) {
 }
 
 bool is_live(const std::string& state) {
-  return state == "PENDING" || state == "RUNNING" || state == "COMPLETING" ||
-         state == "REQUEUED" || state == "CONFIGURING";
+  return state == "PENDING" || state == "RUNNING" || state == "COMPLETING" || state == "REQUEUED" ||
+         state == "CONFIGURING";
 }
 
 /// A requeued task waits two minutes (SLURM's requeue delay); an administrator may start it
@@ -237,7 +236,8 @@ TEST(Slurm, RequeuedKilledAndTimedOutTasksResumeAndSyncToTheLocalResult) {
     SCOPED_TRACE(i);
     EXPECT_EQ(count(logs, fmt::format("job {}: resuming level 0", jobs[i])), 1u) << logs;
   }
-  for (const std::string& job : jobs) EXPECT_EQ(count(logs, fmt::format("job {}: done in", job)), 1u);
+  for (const std::string& job : jobs)
+    EXPECT_EQ(count(logs, fmt::format("job {}: done in", job)), 1u);
   // Claimed once by the first array; the killed job once more, by the second.
   const std::vector<db::JobResult> results = sweep.results();
   EXPECT_EQ(results[0].job.attempt, 1);
@@ -297,8 +297,8 @@ TEST(Slurm, FailedSubmissionsSayWhatToFixAndLeaveTheStoreUnchanged) {
   ASSERT_NO_FATAL_FAILURE(require_cluster());
   const SlurmSweep sweep("slurm_bad");
   const std::string before = store_snapshot(sweep);
-  const std::vector<std::string> submit{PSQ_EXECUTABLE, "slurm", "submit", "k",
-                                        "--db", sweep.db.string()};
+  const std::vector<std::string> submit{PSQ_EXECUTABLE, "slurm",          "submit", "k",
+                                        "--db",         sweep.db.string()};
   const auto with_environment = [&](const std::string& variable) {
     std::vector<std::string> arguments{variable};
     arguments.insert(arguments.end(), submit.begin(), submit.end());
