@@ -82,10 +82,31 @@ constexpr const char* kStaticResiduals = R"sql(
 ALTER TABLE levels ADD COLUMN static_residuals TEXT NOT NULL DEFAULT '[]';
 )sql";
 
+// Jobs run as SLURM array tasks (docs/slurm.md). The job itself stays `running` under a lease
+// owned by "slurm:<array>_<index>" while the cluster has it; a row here remembers which array
+// task holds which claim (attempt) and what the scheduler last said about it, so that `psq
+// status` can show cluster state without asking the cluster.
+constexpr const char* kSlurmTasks = R"sql(
+CREATE TABLE slurm_tasks (
+  job_id       TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+  attempt      INTEGER NOT NULL CHECK (attempt >= 1),
+  array_id     TEXT NOT NULL,
+  task_index   INTEGER NOT NULL CHECK (task_index >= 0),
+  manifest     TEXT NOT NULL,
+  state        TEXT NOT NULL,
+  reason       TEXT NOT NULL DEFAULT '',
+  submitted_at REAL NOT NULL,
+  synced_at    REAL,
+  PRIMARY KEY (job_id, attempt)
+) WITHOUT ROWID;
+CREATE INDEX slurm_tasks_by_array ON slurm_tasks (array_id, task_index);
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
     Migration{2, "static residuals of the settled frames of each level", kStaticResiduals},
+    Migration{3, "SLURM array tasks holding jobs", kSlurmTasks},
 };
 
 constexpr const char* kVersionTable = R"sql(

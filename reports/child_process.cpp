@@ -37,10 +37,14 @@ class FileActions {
 }  // namespace
 
 ChildExit run_child(const std::string& program, const std::vector<std::string>& arguments,
-                    const std::filesystem::path& error_file) {
+                    const std::filesystem::path& error_file,
+                    const std::filesystem::path& output_file) {
   FileActions actions;
   actions.open(STDIN_FILENO, "/dev/null", O_RDONLY);
-  actions.open(STDOUT_FILENO, "/dev/null", O_WRONLY);
+  if (output_file.empty())
+    actions.open(STDOUT_FILENO, "/dev/null", O_WRONLY);
+  else
+    actions.open(STDOUT_FILENO, output_file, O_WRONLY | O_CREAT | O_TRUNC);
   actions.open(STDERR_FILENO, error_file, O_WRONLY | O_CREAT | O_TRUNC);
   std::vector<char*> argv{const_cast<char*>(program.c_str())};
   for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));

@@ -14,11 +14,13 @@ struct ChildExit {
   std::string errors;  ///< what it wrote to stderr
 };
 
-/// Runs `program` (looked up in PATH unless it contains a '/') with `arguments`, stdin and
-/// stdout on /dev/null, stderr captured through the file `error_file`, and waits for it.
-/// Throws InputError naming the program if it cannot be started (not found, not executable).
+/// Runs `program` (looked up in PATH unless it contains a '/') with `arguments`, stdin on
+/// /dev/null, stdout into `output_file` (/dev/null when empty), stderr captured through the
+/// file `error_file`, and waits for it. Throws InputError naming the program if it cannot be
+/// started (not found, not executable).
 ChildExit run_child(const std::string& program, const std::vector<std::string>& arguments,
-                    const std::filesystem::path& error_file);
+                    const std::filesystem::path& error_file,
+                    const std::filesystem::path& output_file = {});
 
 /// The bytes a child process wrote to `file`; empty if the file is missing.
 std::string read_child_output(const std::filesystem::path& file);

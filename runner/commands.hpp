@@ -29,5 +29,6 @@ void register_cancel_command(CLI::App& app, std::vector<Command>& commands);
 void register_retry_command(CLI::App& app, std::vector<Command>& commands);
 void register_report_command(CLI::App& app, std::vector<Command>& commands);
 void register_hierarchy_command(CLI::App& app, std::vector<Command>& commands);
+void register_slurm_command(CLI::App& app, std::vector<Command>& commands);
 
 }  // namespace psq::runner

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   psq::runner::register_retry_command(app, commands);
   psq::runner::register_report_command(app, commands);
   psq::runner::register_hierarchy_command(app, commands);
+  psq::runner::register_slurm_command(app, commands);
   try {
     app.parse(argc, argv);
     for (const auto& command : commands)

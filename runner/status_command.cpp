@@ -1,5 +1,5 @@
-// `psq status [SWEEP] [--json]`: job counts per state of each sweep, and the failures with
-// their messages.
+// `psq status [SWEEP] [--json]`: job counts per state of each sweep, the failures with their
+// messages, and the SLURM array tasks holding its jobs as the last `psq slurm sync` saw them.
 
 #include <fmt/format.h>
 
@@ -8,6 +8,7 @@
 
 #include "db/job_store.hpp"
 #include "runner/commands.hpp"
+#include "runner/slurm_tasks.hpp"
 #include "runner/workspace.hpp"
 
 namespace psq::runner {
@@ -19,19 +20,25 @@ struct StatusOptions {
   bool json = false;
 };
 
-/// One sweep's counts and failures.
+/// One sweep's counts, failures and cluster tasks.
 struct SweepReport {
   db::SweepStatus status;
   std::vector<db::Job> failures;
+  /// Per SLURM array: how many of its tasks hold a job, by the state SLURM last reported.
+  std::map<std::string, std::map<std::string, int>> cluster;
 };
 
 std::vector<SweepReport> gather(db::JobStore& store, const std::string& sweep) {
   std::vector<db::SweepStatus> statuses =
       sweep.empty() ? store.status() : std::vector{store.status(sweep)};
+  slurm::SlurmTaskTable tasks(store.path());
   std::vector<SweepReport> reports;
   for (db::SweepStatus& status : statuses) {
     std::vector<db::Job> failures = store.failures(db::JobSelection::sweep(status.name));
-    reports.push_back({std::move(status), std::move(failures)});
+    std::map<std::string, std::map<std::string, int>> cluster;
+    for (const slurm::SlurmTask& task : tasks.holding(status.name))
+      ++cluster[task.array_id][task.state];
+    reports.push_back({std::move(status), std::move(failures), std::move(cluster)});
   }
   return reports;
 }
@@ -51,12 +58,16 @@ nlohmann::json to_json(const std::filesystem::path& database,
                           {"failures", job.failures},
                           {"max_attempts", job.max_attempts},
                           {"error", job.error}});
+    nlohmann::json cluster = nlohmann::json::array();
+    for (const auto& [array_id, states] : report.cluster)
+      cluster.push_back({{"array_id", array_id}, {"tasks", states}});
     sweeps.push_back({{"name", report.status.name},
                       {"source", report.status.source},
                       {"total", report.status.total()},
                       {"counts", counts},
                       {"expired_leases", report.status.expired_leases},
-                      {"failures", failures}});
+                      {"failures", failures},
+                      {"slurm", cluster}});
   }
   return {{"database", database.string()}, {"sweeps", sweeps}};
 }
@@ -74,6 +85,13 @@ void print_text(const std::filesystem::path& database, const std::vector<SweepRe
           "  {} running jobs stopped sending heartbeats (reclaimed by the "
           "next claim)\n",
           report.status.expired_leases);
+    for (const auto& [array_id, states] : report.cluster) {
+      std::string tasks;
+      for (const auto& [state, count] : states)
+        tasks += fmt::format("{}{} {}", tasks.empty() ? "" : ", ", count, state);
+      std::cout << fmt::format("  SLURM array {}: {} (as of the last psq slurm sync)\n", array_id,
+                               tasks);
+    }
     for (const db::Job& job : report.failures)
       std::cout << fmt::format("  {} {} ({}/{} failed attempts) {}: {}\n", db::to_string(job.state),
                                job.id, job.failures, job.max_attempts, job.parameters.dump(),

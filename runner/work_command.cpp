@@ -36,14 +36,6 @@ extern "C" void on_stop_signal(int signal) {
   stop_requested = true;
 }
 
-void install_stop_handlers() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
-}
-
 std::string host_name() {
   char name[256] = {};
   ::gethostname(name, sizeof name - 1);
@@ -61,8 +53,18 @@ int exit_code(bool any_failed) {
   return any_failed ? kExitJobsFailed : 0;
 }
 
-/// Runs the worker loop in this process.
-int work_here(const WorkSettings& settings, const std::filesystem::path& database) {
+}  // namespace
+
+void install_stop_handlers(std::initializer_list<int> signals) {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  for (int signal : signals) ::sigaction(signal, &action, nullptr);
+}
+
+int stop_signal() { return stop_requested ? last_signal.load() : 0; }
+
+int work_in_this_process(const WorkSettings& settings, const WorkerPlacement& placement) {
   const bool supervised = settings.worker_number > 0;
   // A supervised worker's stderr is a pipe to its supervisor, which draws the status line.
   jobs::ProgressDisplay display(stderr, !supervised && ::isatty(STDERR_FILENO));
@@ -81,12 +83,11 @@ int work_here(const WorkSettings& settings, const std::filesystem::path& databas
   options.lease_seconds = settings.lease_seconds;
   if (!settings.sweep.empty()) options.selection = db::JobSelection::sweep(settings.sweep);
   options.executor = {settings.snapshot_iterations, settings.snapshot_seconds, PSQ_VERSION};
-  const auto make_solver = [cache = hierarchy_cache_directory(database)](const Scene& scene,
-                                                                         int depth) {
+  const auto make_solver = [cache = placement.cache](const Scene& scene, int depth) {
     return jobs::make_level_solver(scene, depth, cache);
   };
-  const jobs::WorkerSummary summary = jobs::run_worker(database, runs_directory(database),
-                                                       make_solver, options, events, stop_requested);
+  const jobs::WorkerSummary summary = jobs::run_worker(
+      placement.database, placement.runs, make_solver, options, events, stop_requested);
   display.clear();
   if (!supervised)
     display.log(fmt::format("psq work: {} done, {} failed{}{}", summary.done, summary.failed,
@@ -94,6 +95,8 @@ int work_here(const WorkSettings& settings, const std::filesystem::path& databas
                             summary.lease_lost ? ", some stopped on a lost lease" : ""));
   return exit_code(summary.failed > 0);
 }
+
+namespace {
 
 /// Supervises `count` worker processes.
 int work_in_processes(const WorkSettings& settings, const std::filesystem::path& database,
@@ -135,9 +138,11 @@ int work_in_processes(const WorkSettings& settings, const std::filesystem::path&
 int run_work(const WorkSettings& settings) {
   const std::filesystem::path database = database_path(settings.database);
   require_database(database);
-  install_stop_handlers();
+  install_stop_handlers({SIGINT, SIGTERM});
   const int count = settings.worker_number > 0 ? 1 : worker_count(settings);
-  return count == 1 ? work_here(settings, database) : work_in_processes(settings, database, count);
+  if (count > 1) return work_in_processes(settings, database, count);
+  return work_in_this_process(
+      settings, {database, runs_directory(database), hierarchy_cache_directory(database)});
 }
 
 void register_work_command(CLI::App& app, std::vector<Command>& commands) {

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -62,5 +63,24 @@ void add_work_options(CLI::App& command, WorkSettings& settings);
 /// Runs queued jobs until none is left (see docs/runner.md); returns the exit code: 0 when
 /// every job run finished, 5 when one failed, 128 + signal when stopped by a signal.
 int run_work(const WorkSettings& settings);
+
+/// Where a worker reads and writes: its store, the job directories and the hierarchy cache.
+/// `psq work` keeps the last two beside the store; a SLURM array task has a store of its own
+/// inside the job's directory (docs/slurm.md).
+struct WorkerPlacement {
+  std::filesystem::path database;
+  std::filesystem::path runs;
+  std::filesystem::path cache;
+};
+
+/// The worker loop of run_work in this process, against `placement`; the same exit codes.
+/// install_stop_handlers must have been called.
+int work_in_this_process(const WorkSettings& settings, const WorkerPlacement& placement);
+
+/// The first of these signals makes the worker checkpoint the job in progress, release it and
+/// return; a second one exits at once.
+void install_stop_handlers(std::initializer_list<int> signals);
+/// The signal that stopped the worker; 0 if none came.
+int stop_signal();
 
 }  // namespace psq::runner

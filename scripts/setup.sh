@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox  # plots in sweep reports (psq report)
   chromium     # headless browser: the test that opens the HTML report
+  slurm-wlm munge  # the single-node SLURM cluster of the psq slurm tests (scripts/slurm-localhost.sh)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,326 @@
+// `psq slurm` against the single-node cluster of scripts/slurm-localhost.sh (started here if
+// it is not running; this test fails, never skips, when it cannot be). A 4-job sweep runs as
+// an array: one task is requeued mid-level (scontrol requeue), one killed mid-level (scancel
+// --batch --signal=KILL: no chance to checkpoint), one gets SLURM's time-limit warning
+// (SIGUSR1, as --signal=B:USR1@S sends it) mid-level and requeues itself; each continues from
+// its last checkpoint, and after sync every job is done once with the result of a local run.
+// Bad input: no sbatch, a cluster that does not answer, an unknown partition.
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <regex>
+#include <thread>
+
+#include "db/job_store.hpp"
+#include "engine/io/checkpoint.hpp"
+#include "runner/cantilever_workspace.hpp"
+#include "support/run_process.hpp"
+#include "support/test_paths.hpp"
+
+namespace psq {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+/// The sweep: four cantilevers of 200 frames (5-10 s each, long enough to act mid-level).
+struct SlurmSweep : test::CantileverWorkspace {
+  explicit SlurmSweep(const std::string& name) : CantileverWorkspace(name) {
+    const test::ProcessResult added =
+        add_sweep("k",
+                  "\"shell.strip.material.thickness\" = [5e-4, 6e-4, 7e-4, 8e-4]\n"
+                  "\"shell.strip.material.youngs_modulus\" = [5e6]\n"
+                  "\"time.frames\" = [200]\n");
+    EXPECT_EQ(added.exit_code, 0) << added.errors;
+  }
+  Checkpoint final_checkpoint(const std::string& job) const {
+    return read_checkpoint(dir / "runs" / job / "level_0.h5");
+  }
+};
+
+test::ProcessResult run(const std::string& program, const std::vector<std::string>& arguments) {
+  return test::run_process(program, arguments);
+}
+
+bool node_ready() {
+  const std::string state =
+      run("/usr/bin/sinfo", {"--noheader", "--nodes=localhost", "--format=%T"}).output;
+  return state.starts_with("idle") || state.starts_with("mixed") || state.starts_with("allocated");
+}
+
+/// Uses the localhost cluster, starting it (as root) if its node is not ready. Never skips: a
+/// cluster that cannot start fails the test.
+void require_cluster() {
+  if (node_ready()) return;
+  const test::ProcessResult started =
+      run((test::source_dir() / "scripts/slurm-localhost.sh").string(), {"start"});
+  ASSERT_EQ(started.exit_code, 0) << "the localhost SLURM cluster did not start (run as root; see "
+                                     "scripts/slurm-localhost.sh):\n"
+                                  << started.output << started.errors;
+  ASSERT_TRUE(node_ready());
+}
+
+struct Seen {
+  std::string state;
+  std::string reason;
+};
+
+/// array task name ("A_i") → SLURM state and reason, from squeue.
+std::map<std::string, Seen> task_states(const std::string& array_id) {
+  const test::ProcessResult q = run("/usr/bin/squeue", {"--noheader", "--array", "--states=all",
+                                                        "--jobs=" + array_id, "--format=%i %T %r"});
+  std::map<std::string, Seen> states;
+  std::istringstream lines(q.output);
+  for (std::string task, state, reason; lines >> task >> state >> reason;)
+    states[task] = {state, reason};
+  return states;
+}
+
+bool is_live(const std::string& state) {
+  return state == "PENDING" || state == "RUNNING" || state == "COMPLETING" || state == "REQUEUED" ||
+         state == "CONFIGURING";
+}
+
+/// A requeued task waits two minutes (SLURM's requeue delay); an administrator may start it
+/// sooner, but not within the second of the requeue: slurmd refuses a launch whose credential
+/// is no newer than the revoked one of the killed instance ("Job credential revoked").
+void start_requeued_now(const std::string& array_id) {
+  static std::map<std::string, Clock::time_point> first_seen;
+  for (const auto& [task, seen] : task_states(array_id)) {
+    if (seen.state != "PENDING" || seen.reason != "BeginTime") {
+      first_seen.erase(task);
+      continue;
+    }
+    const auto [at, added] = first_seen.emplace(task, Clock::now());
+    if (Clock::now() - at->second > std::chrono::seconds(3)) {
+      run("/usr/bin/scontrol", {"update", "JobId=" + task, "StartTime=now"});
+      first_seen.erase(at);
+    }
+  }
+}
+
+void wait_until(const std::function<bool()>& done, double seconds, const std::string& what,
+                const std::string& array_id) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+  while (!done()) {
+    ASSERT_LT(Clock::now(), deadline) << "timed out waiting for " << what;
+    start_requeued_now(array_id);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+}
+
+std::string submitted_array(const test::ProcessResult& submit) {
+  std::smatch match;
+  EXPECT_TRUE(std::regex_search(submit.output, match, std::regex("array job ([0-9]+)")))
+      << submit.output << submit.errors;
+  return match.size() > 1 ? match[1].str() : "";
+}
+
+/// Every level_0 snapshot or checkpoint of the job: it is mid-level once one exists.
+bool has_snapshot(const SlurmSweep& sweep, const std::string& job) {
+  return fs::exists(sweep.dir / "runs" / job / "level_0.snapshot.h5");
+}
+
+/// The text of every task log of every submission of the sweep.
+std::string all_task_logs(const SlurmSweep& sweep) {
+  std::string text;
+  for (const auto& entry : fs::recursive_directory_iterator(sweep.dir / "slurm"))
+    if (entry.path().extension() == ".log") text += test::read_file(entry.path());
+  return text;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+void expect_equal_to_local_run(const SlurmSweep& cluster, const SlurmSweep& local) {
+  const std::vector<db::JobResult> expected = local.results();
+  const std::vector<db::JobResult> actual = cluster.results();
+  ASSERT_EQ(actual.size(), expected.size());
+  for (std::size_t j = 0; j < actual.size(); ++j) {
+    SCOPED_TRACE(actual[j].job.id);
+    ASSERT_EQ(actual[j].job.id, expected[j].job.id);
+    EXPECT_EQ(actual[j].job.state, db::JobState::done) << actual[j].job.error;
+    ASSERT_EQ(actual[j].levels.size(), expected[j].levels.size());
+    for (std::size_t l = 0; l < actual[j].levels.size(); ++l) {
+      EXPECT_EQ(actual[j].levels[l].status, db::LevelStatus::done);
+      EXPECT_EQ(actual[j].levels[l].iterations, expected[j].levels[l].iterations);
+      ASSERT_EQ(actual[j].levels[l].residuals.size(), expected[j].levels[l].residuals.size());
+      for (std::size_t k = 0; k < actual[j].levels[l].residuals.size(); ++k)
+        EXPECT_NEAR(actual[j].levels[l].residuals[k], expected[j].levels[l].residuals[k],
+                    1e-9 * (1.0 + std::abs(expected[j].levels[l].residuals[k])));
+    }
+    const Checkpoint a = cluster.final_checkpoint(actual[j].job.id);
+    const Checkpoint b = local.final_checkpoint(expected[j].job.id);
+    ASSERT_EQ(a.positions.rows(), b.positions.rows());
+    EXPECT_LE((a.positions - b.positions).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
+TEST(Slurm, RequeuedKilledAndTimedOutTasksResumeAndSyncToTheLocalResult) {
+  ASSERT_NO_FATAL_FAILURE(require_cluster());
+  SlurmSweep local("slurm_local");
+  const test::ProcessResult work = local.psq({"work", "--workers", "1"});
+  ASSERT_EQ(work.exit_code, 0) << work.errors;
+
+  SlurmSweep sweep("slurm_cluster");
+  const test::ProcessResult submit =
+      sweep.psq({"slurm", "submit", "k", "--partition", "debug", "--max-parallel", "2", "--time",
+                 "10", "--mem", "200M", "--snapshot-iterations", "3"});
+  ASSERT_EQ(submit.exit_code, 0) << submit.errors;
+  const std::string array = submitted_array(submit);
+  std::vector<std::string> jobs;
+  for (const db::JobResult& r : sweep.results()) {
+    EXPECT_EQ(r.job.state, db::JobState::running);
+    EXPECT_EQ(r.job.lease_owner, fmt::format("slurm:{}_{}", array, jobs.size()));
+    jobs.push_back(r.job.id);
+  }
+  ASSERT_EQ(jobs.size(), 4u);
+  const test::ProcessResult status = sweep.psq({"status", "k"});
+  EXPECT_NE(status.output.find("SLURM array " + array + ": 4 PENDING"), std::string::npos)
+      << status.output;
+
+  const auto task = [&](int i) { return fmt::format("{}_{}", array, i); };
+  // Task 0: requeued by the scheduler mid-level (SIGTERM: it checkpoints, SLURM runs it again).
+  wait_until([&] { return has_snapshot(sweep, jobs[0]); }, 60, "task 0 mid-level", array);
+  EXPECT_EQ(run("/usr/bin/scontrol", {"requeue", task(0)}).exit_code, 0);
+  // Task 1: killed outright mid-level; it resumes from its last periodic snapshot.
+  wait_until([&] { return has_snapshot(sweep, jobs[1]); }, 60, "task 1 mid-level", array);
+  EXPECT_EQ(run("/usr/bin/scancel", {"--batch", "--signal=KILL", task(1)}).exit_code, 0);
+  // Task 2: the warning before its time limit; it checkpoints and requeues itself.
+  wait_until([&] { return has_snapshot(sweep, jobs[2]); }, 60, "task 2 mid-level", array);
+  EXPECT_EQ(run("/usr/bin/scancel", {"--batch", "--signal=USR1", task(2)}).exit_code, 0);
+  wait_until(
+      [&] {
+        for (const auto& [name, seen] : task_states(array))
+          if (is_live(seen.state)) return false;
+        return true;
+      },
+      150, "the array to end", array);
+
+  const test::ProcessResult first_sync = sweep.psq({"slurm", "sync", "k"});
+  ASSERT_EQ(first_sync.exit_code, 0) << first_sync.errors;
+  EXPECT_NE(first_sync.output.find("3 done, 0 failed, 1 queued again"), std::string::npos)
+      << first_sync.output;
+  EXPECT_NE(first_sync.output.find("SLURM array task " + task(1) + " ended (FAILED"),
+            std::string::npos)
+      << first_sync.output;
+  const std::optional<db::Job> killed = db::JobStore(sweep.db).find_job(jobs[1]);
+  ASSERT_TRUE(killed);
+  EXPECT_EQ(killed->state, db::JobState::queued);
+  EXPECT_EQ(killed->failures, 0) << "it made progress before the kill";
+  EXPECT_NE(first_sync.output.find("without a result"), std::string::npos) << first_sync.output;
+
+  // The killed job goes to the cluster again and continues from its checkpoint.
+  const test::ProcessResult again = sweep.psq({"slurm", "submit", "k", "--partition", "debug"});
+  ASSERT_EQ(again.exit_code, 0) << again.errors;
+  const std::string second = submitted_array(again);
+  EXPECT_NE(again.output.find("1 jobs submitted"), std::string::npos) << again.output;
+  wait_until(
+      [&] {
+        const auto states = task_states(second);
+        return !states.empty() && !is_live(states.begin()->second.state);
+      },
+      90, "the second array to end", second);
+  const test::ProcessResult second_sync = sweep.psq({"slurm", "sync"});
+  EXPECT_NE(second_sync.output.find("1 done, 0 failed, 0 queued again"), std::string::npos)
+      << second_sync.output;
+
+  expect_equal_to_local_run(sweep, local);
+  const std::string logs = all_task_logs(sweep);
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(count(logs, fmt::format("job {}: resuming level 0", jobs[i])), 1u) << logs;
+  }
+  for (const std::string& job : jobs)
+    EXPECT_EQ(count(logs, fmt::format("job {}: done in", job)), 1u);
+  // Claimed once by the first array; the killed job once more, by the second.
+  const std::vector<db::JobResult> results = sweep.results();
+  EXPECT_EQ(results[0].job.attempt, 1);
+  EXPECT_EQ(results[1].job.attempt, 2);
+  EXPECT_EQ(results[2].job.attempt, 1);
+  EXPECT_EQ(results[3].job.attempt, 1);
+
+  // Idempotent: another sync changes nothing.
+  const test::ProcessResult third_sync = sweep.psq({"slurm", "sync", "k"});
+  EXPECT_NE(third_sync.output.find("0 done, 0 failed, 0 queued again"), std::string::npos)
+      << third_sync.output;
+  expect_equal_to_local_run(sweep, local);
+}
+
+TEST(Slurm, SyncCancelsTheTasksOfJobsCancelledInTheStore) {
+  ASSERT_NO_FATAL_FAILURE(require_cluster());
+  const SlurmSweep sweep("slurm_cancel");
+  const test::ProcessResult submit = sweep.psq({"slurm", "submit", "k", "--max-parallel", "1"});
+  ASSERT_EQ(submit.exit_code, 0) << submit.errors;
+  const std::string array = submitted_array(submit);
+  ASSERT_EQ(sweep.psq({"cancel", "k"}).exit_code, 0);
+  const test::ProcessResult sync = sweep.psq({"slurm", "sync", "k"});
+  ASSERT_EQ(sync.exit_code, 0) << sync.errors;
+  EXPECT_EQ(count(sync.output, "cancelled in the store; task cancelled"), 4u) << sync.output;
+  wait_until(
+      [&] {
+        for (const auto& [name, seen] : task_states(array))
+          if (seen.state != "CANCELLED") return false;
+        return true;
+      },
+      30, "the tasks to be cancelled", array);
+  for (const db::JobResult& r : sweep.results()) EXPECT_EQ(r.job.state, db::JobState::cancelled);
+  // Once cancelled, a task is not cancelled again.
+  EXPECT_EQ(count(sweep.psq({"slurm", "sync", "k"}).output, "task cancelled"), 0u);
+}
+
+/// The store's jobs as text, and whether a submission left files behind.
+std::string store_snapshot(const SlurmSweep& sweep) {
+  std::string text;
+  for (const db::JobResult& r : sweep.results())
+    text += fmt::format("{} {} {} {} {}\n", r.job.id, db::to_string(r.job.state), r.job.attempt,
+                        r.job.failures, r.levels.size());
+  const test::ProcessResult status = sweep.psq({"status", "--json"});
+  return text + status.output;
+}
+
+void expect_refused(const SlurmSweep& sweep, const test::ProcessResult& result,
+                    const std::vector<std::string>& message_parts, const std::string& before) {
+  EXPECT_EQ(result.exit_code, 1) << result.output << result.errors;
+  for (const std::string& part : message_parts)
+    EXPECT_NE(result.errors.find(part), std::string::npos) << result.errors;
+  EXPECT_EQ(store_snapshot(sweep), before);
+  EXPECT_TRUE(!fs::exists(sweep.dir / "slurm") || fs::is_empty(sweep.dir / "slurm"));
+}
+
+TEST(Slurm, FailedSubmissionsSayWhatToFixAndLeaveTheStoreUnchanged) {
+  ASSERT_NO_FATAL_FAILURE(require_cluster());
+  const SlurmSweep sweep("slurm_bad");
+  const std::string before = store_snapshot(sweep);
+  const std::vector<std::string> submit{PSQ_EXECUTABLE, "slurm",          "submit", "k",
+                                        "--db",         sweep.db.string()};
+  const auto with_environment = [&](const std::string& variable) {
+    std::vector<std::string> arguments{variable};
+    arguments.insert(arguments.end(), submit.begin(), submit.end());
+    return run("/usr/bin/env", arguments);
+  };
+
+  expect_refused(sweep, with_environment("PATH=/nonexistent"),
+                 {"sbatch is not on PATH", "slurm-client"}, before);
+
+  // A configuration whose controller port nobody listens on: the cluster is down.
+  std::string conf = test::read_file("/etc/slurm/slurm.conf");
+  conf = std::regex_replace(conf, std::regex("SlurmctldHost=localhost"),
+                            "SlurmctldHost=localhost\nSlurmctldPort=6999");
+  const fs::path down = test::write_file(sweep.dir / "down.conf", conf);
+  expect_refused(sweep, with_environment("SLURM_CONF=" + down.string()),
+                 {"Unable to contact slurm controller", "scontrol ping"}, before);
+
+  expect_refused(sweep, sweep.psq({"slurm", "submit", "k", "--partition", "nosuchpartition"}),
+                 {"nvalid partition", "sinfo --summarize"}, before);
+
+  expect_refused(sweep, sweep.psq({"slurm", "submit", "nosuchsweep"}), {"nosuchsweep"}, before);
+}
+
+}  // namespace
+}  // namespace psq
