@@ -24,8 +24,10 @@ constexpr int kMaxPullRounds = 6;
 /// may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
-/// adaptive_state()'s name of the settling growth index inside a settling step.
+/// adaptive_state()'s names, inside a settling step, of its growth index and of the frame's
+/// iterations taken before it started (to tell, after a restore, whether it took any).
 constexpr const char* kSettleGrowthState = "settling.growth";
+constexpr const char* kSettleStepStartState = "settling.step_start";
 
 /// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
 constexpr int kMaxFrictionIterations = 5;
@@ -220,8 +222,8 @@ void QuasistaticSimulation::solve_held_frame(FrameRecord& record, const NewtonSe
 }
 
 void QuasistaticSimulation::settle(FrameRecord& record, const NewtonSettings& settings,
-                                   const NewtonSolver::Progress& progress,
-                                   bool continue_restored) {
+                                   const NewtonSolver::Progress& progress, bool continue_restored,
+                                   int restored_iterations) {
   const double time_step = system_.scene().time.step;
   for (bool restored = continue_restored;; restored = false) {
     NewtonSettings budget = settings;
@@ -230,16 +232,19 @@ void QuasistaticSimulation::settle(FrameRecord& record, const NewtonSettings& se
       record.newton.converged = false;
       break;
     }
-    if (!restored) previous_ = x_;
+    if (!restored) {
+      previous_ = x_;
+      settle_step_start_ = restored_iterations + record.newton.iterations;
+    }
     potential_.set_previous(previous_);
     potential_.set_time_step(settling_time_step(time_step, settle_growth_));
-    const int iterations_before = record.newton.iterations;
     solve_held_frame(record, budget, progress);
     ++record.settle_steps;
     const double change = (x_ - previous_).lpNorm<Eigen::Infinity>() / time_step;
     const bool done = settling_done(settle_growth_, change, settings.tolerance);
     settle_growth_ = next_settling_growth(
-        settle_growth_, record.newton.converged && record.newton.iterations == iterations_before);
+        settle_growth_, record.newton.converged &&
+                            restored_iterations + record.newton.iterations == settle_step_start_);
     if (!record.newton.converged) break;
     if (done) {
       record.static_residual = record.newton.step_norm;
@@ -277,11 +282,11 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
     solve_held_frame(record, settings, counted_progress);
     // The frame's step was the settling schedule's first, at Δt.
     settle_growth_ = next_settling_growth(
-        0, record.newton.converged && record.newton.iterations == 0);
+        0, record.newton.converged && resumed_iterations + record.newton.iterations == 0);
   }
   if (system_.scene().solver.frame_solution == FrameSolution::equilibrium &&
       (record.newton.converged || resumed_in_settling))
-    settle(record, settings, counted_progress, resumed_in_settling);
+    settle(record, settings, counted_progress, resumed_in_settling, resumed_iterations);
   settle_growth_ = 0;
   if (contact_) finish_contact_frame(record);
   record.newton.iterations += resumed_iterations;
@@ -294,7 +299,10 @@ std::map<std::string, double> QuasistaticSimulation::adaptive_state() const {
   std::map<std::string, double> state;
   if (contact_) contact_->save_state(state);
   if (strain_limit_) strain_limit_->save_state(state);
-  if (settle_growth_ > 0) state[kSettleGrowthState] = settle_growth_;
+  if (settle_growth_ > 0) {
+    state[kSettleGrowthState] = settle_growth_;
+    state[kSettleStepStartState] = settle_step_start_;
+  }
   return state;
 }
 
@@ -321,7 +329,12 @@ void QuasistaticSimulation::restore(int frame, const Eigen::VectorXd& positions,
   frame_ = in_progress ? frame - 1 : frame;
   resumed_iterations_ = iterations_in_frame;
   const auto growth = adaptive_state.find(kSettleGrowthState);
-  settle_growth_ = in_progress && growth != adaptive_state.end() ? static_cast<int>(growth->second) : 0;
+  const auto step_start = adaptive_state.find(kSettleStepStartState);
+  const bool settling = in_progress && growth != adaptive_state.end();
+  settle_growth_ = settling ? static_cast<int>(growth->second) : 0;
+  settle_step_start_ = settling && step_start != adaptive_state.end()
+                           ? static_cast<int>(step_start->second)
+                           : iterations_in_frame;
 }
 
 }  // namespace psq

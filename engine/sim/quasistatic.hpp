@@ -152,8 +152,10 @@ class QuasistaticSimulation {
   /// Settling steps at the frame's loading (settling.hpp) from growth index settle_growth_
   /// until the equilibrium test passes or record.newton has used settings.max_iterations. With
   /// `continue_restored`, the first step continues a restored one (xᵗ = previous_).
+  /// `restored_iterations`: the frame's iterations before the restore, not in record.
   void settle(FrameRecord& record, const NewtonSettings& settings,
-              const NewtonSolver::Progress& progress, bool continue_restored);
+              const NewtonSolver::Progress& progress, bool continue_restored,
+              int restored_iterations);
 
   ShellSystem system_;
   IncrementalPotential potential_;
@@ -176,6 +178,9 @@ class QuasistaticSimulation {
   int resumed_iterations_ = 0;
   /// Growth index of the settling step being solved; 0 outside settling (the frame's step).
   int settle_growth_ = 0;
+  /// The frame's iterations (those before a restore included) when the settling step being
+  /// solved started.
+  int settle_step_start_ = 0;
 };
 
 }  // namespace psq
