@@ -4,10 +4,33 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <algorithm>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "engine/core/error.hpp"
+#include "engine/scene/key_suggestion.hpp"
 #include "runner/commands.hpp"
+
+namespace {
+
+/// Refuses a first argument that is neither an option nor a command, naming the nearest command:
+/// CLI11 would otherwise take `psq promte --help` for the top-level --help and exit 0.
+void require_known_command(int argc, char** argv, CLI::App& app) {
+  if (argc < 2 || argv[1][0] == '-') return;
+  std::vector<std::string> names;
+  for (const CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+    names.push_back(command->get_name());
+  const std::string given = argv[1];
+  if (std::find(names.begin(), names.end(), given) != names.end()) return;
+  const auto nearest = psq::suggest_key(given, names);
+  throw psq::InputError(fmt::format("unknown command '{}'{}; `psq --help` lists the commands",
+                                    given,
+                                    nearest ? fmt::format(" (did you mean '{}'?)", *nearest) : ""));
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"PSQ: progressive shell quasistatics"};
@@ -28,6 +51,7 @@ int main(int argc, char** argv) {
   psq::runner::register_hierarchy_command(app, commands);
   psq::runner::register_slurm_command(app, commands);
   try {
+    require_known_command(argc, argv, app);
     app.parse(argc, argv);
     for (const auto& command : commands)
       if (command.app->parsed()) return command.run();
