@@ -57,7 +57,8 @@ int positive_from_environment(const char* name, int fallback) {
 int kill_count() { return positive_from_environment("PSQ_SOAK_KILLS", 15); }
 unsigned seed() { return static_cast<unsigned>(positive_from_environment("PSQ_SOAK_SEED", 1)); }
 
-/// A workspace with the soak sweep: the cantilever at depths 1 and 2, `thicknesses` thicknesses.
+/// A workspace with the soak sweep: the cantilever over 20 frames (twice the scene's, so that a
+/// job lasts through a few signals) at depths 1 and 2, `thicknesses` thicknesses.
 struct SoakSweep : test::CantileverWorkspace {
   SoakSweep(const std::string& name, int thicknesses) : CantileverWorkspace(name) {
     std::string values;
@@ -65,7 +66,8 @@ struct SoakSweep : test::CantileverWorkspace {
       values += fmt::format("{}{:.1e}", k ? ", " : "", 5e-4 + 1e-4 * k);
     const test::ProcessResult added =
         add_sweep("soak", fmt::format("depth = [1, 2]\n\"shell.strip.material.thickness\" = [{}]\n"
-                                      "\"shell.strip.material.youngs_modulus\" = [5e6]\n",
+                                      "\"shell.strip.material.youngs_modulus\" = [5e6]\n"
+                                      "\"time.frames\" = [20]\n",
                                       values));
     EXPECT_EQ(added.exit_code, 0) << added.errors;
   }
@@ -135,24 +137,29 @@ struct Deliveries {
   int ints = 0;   ///< by SIGINT (likewise)
 };
 
-/// Keeps two `psq work` processes running on the sweep and ends one of them, chosen at random,
-/// at random moments: `kills` times with SIGKILL, once with SIGTERM (a third of the way) and once
-/// with SIGINT (two thirds). Each ended process is replaced at once. Stops early if the sweep is
-/// settled; then lets the two processes end by themselves.
+/// Keeps two `psq work` processes running on the sweep and ends one of them at random moments:
+/// `kills` times with SIGKILL, once with SIGTERM (a third of the way) and once with SIGINT (two
+/// thirds). Each ended process is replaced at once. Stops early if the sweep is settled; then
+/// lets the two processes end by themselves.
+///
+/// The one ended is the older of the two: a process just started is still loading its job, so
+/// ending it again and again before its first snapshot would make its job a crash loop, which
+/// the retry bound rightly stops (docs/job-store.md). Each process lives through two intervals.
 Deliveries signal_at_random(SoakSweep& sweep, int kills, unsigned seed) {
   std::mt19937 random(seed);
-  std::uniform_int_distribution<int> delay_ms(60, 500);
-  std::uniform_int_distribution<int> which(0, 1);
+  std::uniform_int_distribution<int> delay_ms(100, 600);
   const int signals = kills + 2;
   const int sigterm_at = signals / 3;
   const int sigint_at = 2 * signals / 3;
   std::array<std::unique_ptr<test::PsqChild>, 2> workers{sweep.start_worker(),
                                                          sweep.start_worker()};
   Deliveries delivered;
+  std::size_t older = 0;
   for (int k = 0; k < signals && !sweep.settled(); ++k) {
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(random)));
     const int signal = k == sigterm_at ? SIGTERM : k == sigint_at ? SIGINT : SIGKILL;
-    auto& worker = workers[which(random)];
+    auto& worker = workers[older];
+    older = 1 - older;
     worker->signal(signal);
     const int code = worker->wait();
     // 0: the process had ended by itself, the queue being empty for it.
@@ -178,9 +185,9 @@ void work_until_settled(SoakSweep& sweep) {
 
 TEST(Soak, TwoWorkersKilledAtRandomFinishEveryJobOnceWithTheUninterruptedResult) {
   const int kills = kill_count();
-  // Enough work for the signals to land while jobs are running: at 60-500 ms between them, a
-  // job of either depth takes a few of them.
-  const int thicknesses = std::max(4, (kills + 5) / 4);
+  // Enough work for the signals to land while jobs are running: a job takes about 0.5-1.5 s,
+  // two run at once, a signal comes every 0.35 s on average.
+  const int thicknesses = kills + 4;
 
   SoakSweep reference("soak_reference", thicknesses);
   ASSERT_EQ(reference.start_worker()->wait(), 0);
@@ -225,7 +232,6 @@ TEST(Soak, TwoWorkersKilledAtRandomFinishEveryJobOnceWithTheUninterruptedResult)
       const Checkpoint e = read_checkpoint(expected[j].levels[l].checkpoint_path);
       difference = std::max({difference, max_difference(c.positions, e.positions),
                              max_difference(c.finest_positions, e.finest_positions)});
-      EXPECT_EQ(c.statistics.iterations.size(), e.statistics.iterations.size()) << l;
     }
   }
   EXPECT_EQ(difference, 0.0);
