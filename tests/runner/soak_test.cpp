@@ -230,11 +230,13 @@ TEST(Soak, TwoWorkersKilledAtRandomFinishEveryJobOnceWithTheUninterruptedResult)
       const Checkpoint c =
           read_checkpoint(level.checkpoint_path, parse_checksum(level.checkpoint_checksum));
       const Checkpoint e = read_checkpoint(expected[j].levels[l].checkpoint_path);
-      difference = std::max({difference, max_difference(c.positions, e.positions),
-                             max_difference(c.finest_positions, e.finest_positions)});
+      const double level_difference =
+          std::max(max_difference(c.positions, e.positions),
+                   max_difference(c.finest_positions, e.finest_positions));
+      EXPECT_EQ(level_difference, 0.0) << "level " << l;
+      difference = std::max(difference, level_difference);
     }
   }
-  EXPECT_EQ(difference, 0.0);
   std::cout << fmt::format(
       "soak (seed {}): {} SIGKILLs, {} SIGTERM, {} SIGINT delivered; {} jobs, {} attempts, {} "
       "done exactly once, {} failures counted; max |x - x_uninterrupted| = {}\n",
