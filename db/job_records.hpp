@@ -62,7 +62,9 @@ struct Job {
   /// Claims so far: the fencing token of the latest claim. Never decreases, not even on retry,
   /// so a token handed out once is never valid again after a new claim.
   std::int64_t attempt = 0;
-  std::int64_t failures = 0;  ///< failed attempts since the last retry
+  /// Failed attempts since the last retry: explicit failures, and workers that died without
+  /// progress since the job's last new checkpoint (docs/job-store.md).
+  std::int64_t failures = 0;
   std::int64_t max_attempts = 1;
   std::string lease_owner;  ///< worker holding the lease; empty unless running
   std::optional<double> lease_expiry;

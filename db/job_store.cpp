@@ -58,6 +58,9 @@ void configure(SqliteConnection& connection, int busy_timeout_ms) {
   connection.execute("PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
 }
 
+/// SET clause putting a running job back in the queue with its lease ended.
+constexpr const char* kBackToTheQueue = "state = 'queued', lease_owner = NULL, lease_expiry = NULL";
+
 constexpr const char* kJobColumns =
     "jobs.id, jobs.parameters, jobs.scene, jobs.depth, jobs.state, jobs.attempt, jobs.failures, "
     "jobs.max_attempts, jobs.lease_owner, jobs.lease_expiry, jobs.heartbeat_at, jobs.error, "
@@ -217,14 +220,28 @@ SweepAddition JobStore::add_jobs(const std::string& name, const std::string& sou
 }
 
 void JobStore::expire_leases(double time) {
+  // An attempt that recorded a new checkpoint was interrupted, not crash-looping: its job goes
+  // back to the queue as `psq resume` would put it, with no failure counted.
+  connection_
+      .prepare(fmt::format("UPDATE jobs SET {} WHERE state = 'running' AND lease_expiry <= ?1 AND "
+                           "progress_attempt = attempt",
+                           kBackToTheQueue))
+      .bind_all(time)
+      .run();
+  // The others died without progress: each such death counts, so a job that kills its worker
+  // every time (out of memory, a time limit) is stopped after max_attempts.
   connection_
       .prepare(
-          "UPDATE jobs SET failures = failures + 1, "
+          "UPDATE jobs SET failures = failures + 1, stalls = stalls + 1, "
           "state = CASE WHEN failures + 1 >= max_attempts THEN 'failed' ELSE 'queued' END, "
           "ended_at = CASE WHEN failures + 1 >= max_attempts THEN ?1 ELSE ended_at END, "
           "error = printf('attempt %d by worker %s stopped sending heartbeats (last at %s UTC) "
-          "and its lease expired', attempt, lease_owner, "
-          "strftime('%Y-%m-%d %H:%M:%S', heartbeat_at, 'unixepoch')), "
+          "and its lease expired; its worker died %s without progress (no new checkpoint)%s', "
+          "attempt, lease_owner, strftime('%Y-%m-%d %H:%M:%S', heartbeat_at, 'unixepoch'), "
+          "CASE WHEN stalls = 0 THEN 'once' ELSE printf('%d times in a row', stalls + 1) END, "
+          "CASE WHEN failures + 1 >= max_attempts THEN printf(', which makes %d of the %d failed "
+          "attempts allowed; find what kills the worker (memory? a time limit?), then run psq "
+          "retry', failures + 1, max_attempts) ELSE '' END), "
           "lease_owner = NULL, lease_expiry = NULL "
           "WHERE state = 'running' AND lease_expiry <= ?1")
       .bind_all(time)
@@ -301,14 +318,26 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
         fmt::format("job {}: level {} outside [0, {})", lease.job_id, level.level, depth));
   nlohmann::json timings = nlohmann::json::object();
   for (const auto& [phase, seconds] : level.timings) timings[phase] = seconds;
+  const auto path = unless_empty(level.checkpoint_path);
+  const auto checksum = unless_empty(level.checkpoint_checksum);
+  // Progress is a checkpoint the level's row did not hold yet. A resumed attempt records again
+  // the finished level it resumed from; that repeats the row and is no progress. New progress
+  // also forgives the deaths without progress before it: they were interruptions.
+  connection_
+      .prepare(
+          "UPDATE jobs SET progress_attempt = ?2, failures = failures - stalls, stalls = 0 "
+          "WHERE id = ?1 AND ?5 IS NOT NULL AND NOT EXISTS (SELECT 1 FROM levels "
+          "WHERE job_id = ?1 AND level = ?3 AND status = ?4 AND checkpoint_path IS ?5 "
+          "AND checkpoint_checksum IS ?6)")
+      .bind_all(lease.job_id, lease.attempt, level.level, to_string(level.status), path, checksum)
+      .run();
   connection_
       .prepare(
           "REPLACE INTO levels (job_id, level, status, iterations, residuals, timings, "
           "checkpoint_path, checkpoint_checksum, error, attempt, updated_at, static_residuals) "
           "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)")
       .bind_all(lease.job_id, level.level, to_string(level.status), level.iterations,
-                nlohmann::json(level.residuals).dump(), timings.dump(),
-                unless_empty(level.checkpoint_path), unless_empty(level.checkpoint_checksum),
+                nlohmann::json(level.residuals).dump(), timings.dump(), path, checksum,
                 unless_empty(level.error), lease.attempt, now(),
                 nlohmann::json(level.static_residuals).dump())
       .run();
@@ -341,9 +370,9 @@ void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& er
 
 bool JobStore::release(const Lease& lease) {
   return connection_
-             .prepare(
-                 "UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
-                 "WHERE id = ?1 AND attempt = ?2 AND state = 'running'")
+             .prepare(fmt::format(
+                 "UPDATE jobs SET {} WHERE id = ?1 AND attempt = ?2 AND state = 'running'",
+                 kBackToTheQueue))
              .bind_all(lease.job_id, lease.attempt)
              .run() == 1;
 }
@@ -383,17 +412,17 @@ std::int64_t JobStore::cancel(const JobSelection& which) {
 
 std::int64_t JobStore::requeue_interrupted(const JobSelection& which) {
   return update_selected(
-      which,
-      "UPDATE jobs SET state = 'queued', lease_owner = NULL, lease_expiry = NULL "
-      "WHERE state = 'running' AND lease_expiry <= ?2");
+      which, fmt::format("UPDATE jobs SET {} WHERE state = 'running' AND lease_expiry <= ?2",
+                         kBackToTheQueue));
 }
 
 std::int64_t JobStore::retry(const JobSelection& which, bool include_cancelled) {
   const std::string states = include_cancelled ? "('failed', 'cancelled')" : "('failed')";
-  return update_selected(which,
-                         "UPDATE jobs SET state = 'queued', failures = 0, error = NULL, "
-                         "ended_at = NULL WHERE state IN " +
-                             states);
+  return update_selected(
+      which,
+      "UPDATE jobs SET state = 'queued', failures = 0, stalls = 0, error = NULL, "
+      "ended_at = NULL WHERE state IN " +
+          states);
 }
 
 std::vector<SweepStatus> JobStore::status() {

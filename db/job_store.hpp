@@ -58,9 +58,10 @@ class JobStore {
   SweepAddition preview_sweep(const std::string& name, const std::vector<NewJob>& jobs);
 
   /// Claims the first queued job (in the order jobs were added) for `worker`, with a lease of
-  /// `lease_seconds`. Running jobs whose lease expired are first put back in the queue with
-  /// one more failure (or failed, if that was their last attempt). Returns nothing when no
-  /// job is queued.
+  /// `lease_seconds`. Running jobs whose lease expired are first put back in the queue: with
+  /// no failure counted if the expired attempt recorded a new checkpoint, else with one more
+  /// failure (or failed, if that was their last attempt). Returns nothing when no job is
+  /// queued.
   std::optional<Claim> claim_next(const WorkerInfo& worker, double lease_seconds);
   /// claim_next among the selected jobs only (e.g. one sweep's). Throws InputError for an
   /// unknown sweep or job.
@@ -69,7 +70,8 @@ class JobStore {
   /// Pushes the lease expiry to now + lease.seconds. False if the lease is lost (the worker
   /// must stop the job; its writes would be refused).
   [[nodiscard]] bool heartbeat(const Lease& lease);
-  /// Stores (or replaces) the record of one level. Throws LeaseLostError if the lease is lost,
+  /// Stores (or replaces) the record of one level; one with a checkpoint the row did not hold
+  /// is the attempt's progress. Throws LeaseLostError if the lease is lost,
   /// std::invalid_argument if the level is outside [0, depth).
   void record_level(const Lease& lease, const LevelRecord& level);
   /// Ends the attempt: done, or failed with `error` (queued again while failures stay below

@@ -102,11 +102,20 @@ CREATE TABLE slurm_tasks (
 CREATE INDEX slurm_tasks_by_array ON slurm_tasks (array_id, task_index);
 )sql";
 
+// A worker that dies is only counted against a job's retry bound if its attempt made no
+// progress: `progress_attempt` is the last attempt that recorded a new checkpoint, `stalls` the
+// deaths without progress since then (docs/job-store.md, "Job states").
+constexpr const char* kProgressAwareRetries = R"sql(
+ALTER TABLE jobs ADD COLUMN progress_attempt INTEGER;
+ALTER TABLE jobs ADD COLUMN stalls INTEGER NOT NULL DEFAULT 0 CHECK (stalls >= 0);
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
     Migration{2, "static residuals of the settled frames of each level", kStaticResiduals},
     Migration{3, "SLURM array tasks holding jobs", kSlurmTasks},
+    Migration{4, "progress-aware retries: progress_attempt, stalls", kProgressAwareRetries},
 };
 
 constexpr const char* kVersionTable = R"sql(

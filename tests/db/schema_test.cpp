@@ -94,6 +94,30 @@ TEST(JobStoreSchema, NewerSchemaIsRefusedWithUpgradeAdvice) {
                                  path.string(), future, latest_schema_version()));
 }
 
+TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    store.add_sweep("s", "s.toml", test::thickness_jobs(0, 2));
+  }
+  {
+    // Back to what a store written by a version-3 psq holds.
+    SqliteConnection raw(path, 1000);
+    raw.execute(
+        "ALTER TABLE jobs DROP COLUMN progress_attempt; ALTER TABLE jobs DROP COLUMN stalls; "
+        "DELETE FROM schema_version WHERE version > 3");
+    ASSERT_EQ(schema_version(raw), 3);
+  }
+  JobStore upgraded(path);
+  EXPECT_EQ(upgraded.status("s").total(), 2);
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM pragma_table_info('jobs') WHERE name IN "
+                                "('progress_attempt', 'stalls')"),
+            2);
+  EXPECT_EQ(single_integer(raw, "SELECT SUM(stalls) FROM jobs"), 0);
+}
+
 TEST(JobStoreSchema, FileThatIsNotADatabaseIsRefusedByName) {
   const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
   std::string text;
