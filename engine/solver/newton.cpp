@@ -119,6 +119,12 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
       throw NumericalError(fmt::format("initial position is {} at {}", x[i], dof_name(i)));
 
   NewtonResult result;
+  // Nothing left to take and nothing to judge: a capped step resumed after its last iteration
+  // ends as the uninterrupted one did, without a gradient, Hessian or factorization.
+  if (settings.max_iterations == 0 && !settings.judge_final_iterate) {
+    result.energy = objective.value(x);
+    return result;
+  }
   NewtonIteration record;
   double energy = 0.0;
   {

@@ -28,6 +28,8 @@ struct NewtonSettings {
   /// without knowing. For steps capped by design whose convergence nobody asks (progressive
   /// previews: settling decides when a level is done): at a cap of 2 it saves one of a step's
   /// three gradient–Hessian–factorization rounds (Newton.CappedSolve… counts the gradients).
+  /// With max_iterations = 0 (a capped step resumed after its last iteration) such a solve
+  /// does nothing and returns an empty history.
   bool judge_final_iterate = true;
 };
 

@@ -234,6 +234,13 @@ TEST(Soak, TwoWorkersKilledAtRandomFinishEveryJobOnceWithTheUninterruptedResult)
           std::max(max_difference(c.positions, e.positions),
                    max_difference(c.finest_positions, e.finest_positions));
       EXPECT_EQ(level_difference, 0.0) << "level " << l;
+      // The same Newton records, none repeated or lost across the interruptions.
+      ASSERT_EQ(c.statistics.iterations.size(), e.statistics.iterations.size()) << "level " << l;
+      for (std::size_t k = 0; k < e.statistics.iterations.size(); ++k) {
+        EXPECT_EQ(c.statistics.iterations[k].frame, e.statistics.iterations[k].frame);
+        EXPECT_EQ(c.statistics.iterations[k].iteration, e.statistics.iterations[k].iteration);
+        EXPECT_EQ(c.statistics.iterations[k].step_length, e.statistics.iterations[k].step_length);
+      }
       difference = std::max(difference, level_difference);
     }
   }

@@ -626,6 +626,20 @@ TEST(Newton, AReachableToleranceIsNotStagnation) {
   EXPECT_FALSE(result.stagnated);
 }
 
+TEST(Newton, AnUnjudgedSolveWithNoIterationsLeftDoesNothing) {
+  NoisyQuadratic objective(2, 0.0);
+  NewtonSettings settings;
+  settings.max_iterations = 0;
+  settings.judge_final_iterate = false;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(objective.size());
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(2, {}), settings);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.iterations, 0);
+  EXPECT_TRUE(result.history.empty());  // no record that the uninterrupted capped step lacks
+  EXPECT_TRUE(x.isZero(0.0));
+}
+
 TEST(Newton, RejectsBadSettings) {
   ProbeQuadratic probe(3, 1.0);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
