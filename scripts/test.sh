@@ -13,3 +13,4 @@ trap '$SUDO ./scripts/slurm-localhost.sh stop' EXIT
 $SUDO ./scripts/slurm-localhost.sh start ||
   echo "test.sh: the localhost SLURM cluster did not start; the Slurm tests will fail" >&2
 ctest --test-dir build --output-on-failure -j"$(nproc)" --timeout 900
+./scripts/fuzz.sh  # the fuzz targets, briefly (about 3 minutes on 2 cores; docs/fuzzing.md)

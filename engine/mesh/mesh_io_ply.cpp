@@ -167,7 +167,13 @@ struct PlyLayout {
 PlyLayout find_layout(const PlyHeader& header, const std::string& file) {
   PlyLayout layout;
   bool has_vertex = false;
+  bool has_face = false;
   for (const PlyElement& element : header.elements) {
+    // The layout holds one property index per role, valid for one declaration only.
+    bool& seen = element.name == "vertex" ? has_vertex : has_face;
+    if ((element.name == "vertex" || element.name == "face") && seen)
+      throw InputError(located_message(
+          file, element.line, fmt::format("element '{}' is declared twice", element.name)));
     const auto property_index = [&](auto matches) {
       const auto it = std::find_if(element.properties.begin(), element.properties.end(), matches);
       return it == element.properties.end() ? -1
@@ -184,6 +190,7 @@ PlyLayout find_layout(const PlyHeader& header, const std::string& file) {
                               fmt::format("element 'vertex' needs a scalar property '{}'", name)));
       }
     } else if (element.name == "face") {
+      has_face = true;
       layout.face_indices = property_index([](const PlyProperty& p) {
         return p.name == "vertex_indices" || p.name == "vertex_index";
       });

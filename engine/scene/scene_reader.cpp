@@ -376,9 +376,13 @@ fs::path read_mesh_file(const Section& mesh, const fs::path& scene_path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   mesh.check(extension == ".obj" || extension == ".ply" || extension == ".off", "file",
              fmt::format("an .obj, .ply or .off file (got '{}')", written));
-  if (!fs::is_regular_file(resolved))
-    mesh.fail(mesh.line("file"), fmt::format("mesh file '{}' not found: {} does not exist", written,
-                                             resolved.string()));
+  // Without the error code, a name the OS refuses (e.g. too long) would throw filesystem_error.
+  std::error_code error;
+  if (!fs::is_regular_file(resolved, error))
+    mesh.fail(mesh.line("file"),
+              fmt::format("mesh file '{}' not found: {}", written,
+                          error ? fmt::format("{}: {}", resolved.string(), error.message())
+                                : fmt::format("{} does not exist", resolved.string())));
   return resolved;
 }
 
@@ -691,14 +695,9 @@ Collider read_collider(const Section& section, const fs::path& scene_path) {
   return collider;
 }
 
-toml::table parse_toml(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(located_message(path.string(), 0, "cannot open the scene file"));
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string source = path.string();
+toml::table parse_toml(std::string_view text, const std::string& source) {
   try {
-    return toml::parse(text.str(), std::string_view(source));
+    return toml::parse(text, std::string_view(source));
   } catch (const toml::parse_error& error) {
     std::string message = fmt::format("TOML syntax error: {}", error.description());
     // TOML 1.0 inline tables end at the line's end, a frequent surprise.
@@ -713,7 +712,15 @@ toml::table parse_toml(const fs::path& path) {
 }  // namespace
 
 Scene read_scene(const fs::path& path) {
-  const toml::table document = parse_toml(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(located_message(path.string(), 0, "cannot open the scene file"));
+  std::stringstream text;
+  text << in.rdbuf();
+  return read_scene_text(text.str(), path);
+}
+
+Scene read_scene_text(std::string_view text, const fs::path& path) {
+  const toml::table document = parse_toml(text, path.string());
   const Section root(document, "", path.string());
   root.allow_only(
       {"name", "gravity", "time", "solver", "hierarchy", "contact", "shell", "collider"});

@@ -3,6 +3,7 @@
 // in docs/scene-format.md.
 
 #include <filesystem>
+#include <string_view>
 
 #include "engine/scene/scene.hpp"
 
@@ -17,5 +18,10 @@ namespace psq {
 /// box min > max; motion end < start; zero rotation axes; selectors with zero or several of
 /// box / boundary_loop / vertices; repeated shell or pin names).
 Scene read_scene(const std::filesystem::path& path);
+
+/// read_scene on `text` as if it were the content of the file `path` (which need not exist):
+/// messages name `path` and mesh files are resolved relative to its directory. For callers
+/// that hold the text already, such as the fuzz target.
+Scene read_scene_text(std::string_view text, const std::filesystem::path& path);
 
 }  // namespace psq

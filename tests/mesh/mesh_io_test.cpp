@@ -302,6 +302,23 @@ TEST(MeshIo, PlyErrorsNameFileAndLineOrElement) {
                   0, "empty");
 }
 
+// Found by fuzz_ply: a second 'vertex' element with x, y, z further along its properties
+// than the first's made the reader index past the first element's values (heap overflow).
+TEST(MeshIo, PlyElementDeclaredTwiceIsRejectedAtItsLine) {
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  expect_rejected("twovertex.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                      "element vertex 1\nproperty float a\n" + xyz +
+                      "end_header\n0 0 0\n1 0 0\n0 1 0\n9 1 2 3\n",
+                  7, "element 'vertex' is declared twice");
+  expect_rejected("twoface.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                      "element face 1\nproperty list uchar int vertex_indices\n"
+                      "element face 1\nproperty int a\nproperty list uchar int vertex_indices\n"
+                      "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n7 3 0 1 2\n",
+                  9, "element 'face' is declared twice");
+}
+
 TEST(MeshIo, BinaryPlyErrorsNameTheElement) {
   const std::string good = binary_square_ply(std::endian::little);
   // Cut inside face 1's index list.

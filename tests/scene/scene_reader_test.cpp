@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cerrno>
+#include <cstring>
 #include <tuple>
 
 #include "engine/core/error.hpp"
@@ -485,6 +487,23 @@ TEST(ReadScene, TheValidBaseOfTheBadCasesLoads) {
   ASSERT_EQ(scene.shells.size(), 1u);
   EXPECT_EQ(scene.shells[0].pins.size(), 1u);
   EXPECT_EQ(scene.shells[0].loads.size(), 1u);
+}
+
+// Found by fuzz_scene: a mesh file name longer than the OS allows (ENAMETOOLONG) escaped as
+// std::filesystem::filesystem_error instead of an InputError at the key's line.
+TEST(ReadScene, MeshFileNameTooLongIsAnInputErrorAtItsLine) {
+  const fs::path dir = test::fresh_temp_dir("long_mesh_name");
+  const std::string name = std::string(300, 'k') + ".obj";
+  const fs::path path = test::write_file(
+      dir / "scene.toml", scene_with(9, "mesh = { file = \"" + name + "\" }"));
+  try {
+    read_scene(path);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(path.string() + ":9: ", 0), 0u) << message;
+    EXPECT_NE(message.find(std::strerror(ENAMETOOLONG)), std::string::npos) << message;
+  }
 }
 
 TEST(ReadScene, MissingMeshFileNamesTheSceneLineAndTheResolvedPath) {
