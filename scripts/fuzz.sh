@@ -28,7 +28,7 @@ for target in "${targets[@]}"; do
   log="build-fuzz/fuzz_$target.log"
   # shellcheck disable=SC2086 # seeds[] holds a list of directories
   if ! build-fuzz/tests/fuzz/fuzz_"$target" "build-fuzz/corpus/$target" ${seeds[$target]} \
-    "${limit[@]}" -timeout=10 -max_len=4096 -print_final_stats=1 \
+    "${limit[@]}" -seed=1 -timeout=10 -max_len=4096 -print_final_stats=1 \
     -artifact_prefix=build-fuzz/findings/"$target"- >"$log" 2>&1; then
     tail -n 40 "$log" >&2
     echo "fuzz.sh: fuzz_$target found a problem; its input is in build-fuzz/findings" >&2

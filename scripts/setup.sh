@@ -11,6 +11,7 @@ packages=(
   gnuplot-nox  # plots in sweep reports (psq report)
   chromium     # headless browser: the test that opens the HTML report
   slurm-wlm munge  # the single-node SLURM cluster of the psq slurm tests (scripts/slurm-localhost.sh)
+  clang libclang-rt-14-dev  # libFuzzer and its sanitizers for the fuzz targets (scripts/fuzz.sh)
 )
 missing=()
 for p in "${packages[@]}"; do
