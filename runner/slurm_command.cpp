@@ -237,11 +237,26 @@ struct SyncCounts {
   std::map<std::string, int> on_cluster;  ///< by SLURM state
   int done = 0;
   int failed = 0;
-  int requeued = 0;  ///< back in the store's queue
+  int requeued = 0;             ///< back in the store's queue
+  int requeued_on_cluster = 0;  ///< killed tasks that sync requeued in SLURM
 };
 
+/// `scontrol requeue` of an ended task; false (the job then goes back to the store's queue)
+/// when SLURM refuses, e.g. once the task has left the controller's memory (MinJobAge).
+bool requeue_task(slurm::Scheduler& scheduler, const std::string& task) {
+  try {
+    scheduler.requeue(task);
+    return true;
+  } catch (const InputError& refused) {
+    std::cerr << fmt::format("psq slurm sync: {}; the job goes back to the store's queue\n",
+                             refused.what());
+    return false;
+  }
+}
+
 /// Brings one held job's outcome into the store; returns the task row to record.
-slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJob& held,
+slurm::SlurmTask sync_job(db::JobStore& store, slurm::Scheduler& scheduler, const fs::path& runs,
+                          const HeldJob& held,
                           const std::optional<slurm::TaskState>& seen,
                           const std::optional<slurm::SlurmTask>& known, SyncCounts& counts) {
   const fs::path manifest = known ? known->manifest : "";
@@ -296,18 +311,32 @@ slurm::SlurmTask sync_job(db::JobStore& store, const fs::path& runs, const HeldJ
   const std::string message = fmt::format(
       "SLURM array task {} ended ({}) without a result: it was killed before it could "
       "checkpoint (scancel --signal=KILL, out of memory, node failure) or failed to start; "
-      "its log is {}; psq slurm submit runs it again from its last checkpoint",
+      "its log is {}",
       held.task(), scheduler_word, task_log(manifest, held));
   // An attempt that made progress does not count against the retry bound (DESIGN.md §9): a
   // job that advances through kills always finishes.
   if (checkpointed_since(runs / held.job.id, row.submitted_at)) {
+    // SLURM requeues a finished batch job too: the same task, still holding the job's claim,
+    // runs again from its checkpoint without a new submission. The window for progress
+    // starts anew, so a task killed again and again without advancing ends up below.
+    if (seen && requeue_task(scheduler, held.task())) {
+      row.state = "REQUEUED";
+      row.reason = "killed after progress; requeued by sync";
+      row.submitted_at = unix_now();
+      ++counts.requeued_on_cluster;
+      say(message + "; it made progress: requeued on the cluster, it continues from its "
+                    "last checkpoint");
+      return row;
+    }
     store.release(held.lease());
     row.reason = "killed after progress";
     ++counts.requeued;
-    say(message + " (it made progress: no failure counted)");
+    say(message + "; psq slurm submit runs it again from its last checkpoint (it made "
+                  "progress: no failure counted)");
     return row;
   }
-  store.finish(held.lease(), db::Outcome::failed, message);
+  store.finish(held.lease(), db::Outcome::failed,
+               message + "; psq slurm submit runs it again from its last checkpoint");
   const std::optional<db::Job> now = store.find_job(held.job.id);
   if (now && now->state == db::JobState::queued)
     ++counts.requeued;
@@ -363,7 +392,7 @@ int run_sync(const SyncOptions& options) {
   for (const HeldJob& h : held) {
     const auto seen = states.find(h.task());
     const auto row = known.find({h.job.id, h.job.attempt});
-    rows.push_back(sync_job(store, runs_directory(database), h,
+    rows.push_back(sync_job(store, scheduler, runs_directory(database), h,
                             seen == states.end() ? std::nullopt : std::optional(seen->second),
                             row == known.end() ? std::nullopt : std::optional(row->second),
                             counts));
@@ -372,8 +401,9 @@ int run_sync(const SyncOptions& options) {
   table.record(rows);
   std::string cluster;
   for (const auto& [state, n] : counts.on_cluster) cluster += fmt::format(", {} {}", n, state);
-  std::cout << fmt::format("psq slurm sync: {} done, {} failed, {} queued again{}\n", counts.done,
-                           counts.failed, counts.requeued,
+  std::cout << fmt::format("psq slurm sync: {} done, {} failed, {} queued again, {} requeued on "
+                           "the cluster{}\n",
+                           counts.done, counts.failed, counts.requeued, counts.requeued_on_cluster,
                            cluster.empty() ? ", none left on the cluster" : cluster);
   return 0;
 }

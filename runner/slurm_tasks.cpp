@@ -37,7 +37,8 @@ void SlurmTaskTable::record(const std::vector<SlurmTask>& tasks) {
       "INSERT INTO slurm_tasks (job_id, attempt, array_id, task_index, manifest, state, reason, "
       "submitted_at, synced_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) "
       "ON CONFLICT (job_id, attempt) DO UPDATE SET state = excluded.state, "
-      "reason = excluded.reason, synced_at = excluded.synced_at");
+      "reason = excluded.reason, submitted_at = excluded.submitted_at, "
+      "synced_at = excluded.synced_at");
   for (const SlurmTask& t : tasks)
     upsert.reset()
         .bind_all(t.job_id, t.attempt, t.array_id, t.index, t.manifest, t.state, t.reason,

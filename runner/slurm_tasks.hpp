@@ -27,7 +27,7 @@ struct SlurmTask {
   std::string manifest;
   std::string state;   ///< SLURM's state name, last seen
   std::string reason;  ///< squeue's reason or sacct's exit code; or psq's note
-  double submitted_at = 0;
+  double submitted_at = 0;  ///< when its current run was submitted, or requeued by sync
   std::optional<double> synced_at;
 };
 
@@ -37,7 +37,8 @@ class SlurmTaskTable {
  public:
   explicit SlurmTaskTable(const std::filesystem::path& database);
 
-  /// Adds the tasks, or updates the state, reason and sync time of the ones already there.
+  /// Adds the tasks, or updates the state, reason, submission and sync time of the ones
+  /// already there.
   /// One transaction.
   void record(const std::vector<SlurmTask>& tasks);
   /// The tasks of the sweep (every sweep when empty) that hold their job now: the job is
