@@ -251,7 +251,6 @@ void QuasistaticSimulation::settle(FrameRecord& record, const NewtonSettings& se
       break;
     }
   }
-  settle_growth_ = 0;
   potential_.set_time_step(time_step);
 }
 
