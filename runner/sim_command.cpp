@@ -215,6 +215,9 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
     write_positions(out / fmt::format("level_{}.obj", sim.level()), sim.level_rest_mesh(),
                     sim.positions());
     levels.push_back(level.json());
+    const std::vector<RefinementStats>& refinements = sim.refinements();
+    if (!refinements.empty() && refinements.back().level == sim.level())
+      levels.back()["refinement"] = refinement_json(refinements.back());
     if (sim.finished()) break;
     sim.refine();
   }

@@ -1,12 +1,14 @@
 #include "engine/progressive/level_stepper.hpp"
 
+#include <algorithm>
+
 namespace psq {
 
 LevelStepper::LevelStepper(const ShellSystem& system, std::unique_ptr<LevelObjective> objective,
                            const NewtonSettings& settings)
     : system_(system),
       objective_(std::move(objective)),
-      dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()),
+      frame_solver_(system, objective_->potential()),
       settings_(settings) {}
 
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
@@ -22,7 +24,8 @@ FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame, double time_step,
 
 FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd& x, int frame,
                                double time_step, int iterations_done,
-                               const NewtonSolver::Progress& progress) {
+                               const NewtonSolver::Progress& progress,
+                               const Eigen::VectorXd& frame_start) {
   objective_->set_time_step(time_step);
   objective_->set_previous(previous);
   FrameRecord record;
@@ -30,8 +33,15 @@ FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd&
   record.time = frame * system_.scene().time.step;
   NewtonSettings settings = settings_;
   settings.max_iterations -= iterations_done;
-  record.newton = solve_pinned_step(newton_, *objective_, system_, dofs_, settings, frame, x,
-                                    offset_progress(progress, iterations_done));
+  int taken = iterations_done;
+  const NewtonSolver::Progress numbered = numbered_through_frame(progress, taken);
+  // A settling step's targets are where the pins already are: begin_frame then only raises κ to
+  // the balance at x, if that is higher.
+  frame_solver_.begin_frame(x, record, settings, numbered);
+  settings.max_iterations = std::max(0, settings.max_iterations - record.newton.iterations);
+  frame_solver_.solve_held(x, previous, frame_start.size() > 0 ? frame_start : previous, record,
+                           settings, numbered);
+  frame_solver_.finish_frame(x, record);
   record.newton.iterations += iterations_done;
   record.elastic_energy = objective_->elastic_energy(x);
   return record;

@@ -7,7 +7,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
+#include "engine/sim/contact_term.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 
 namespace psq {
@@ -24,6 +26,18 @@ constexpr const char* kSettled = "progressive.settled";
 constexpr const char* kLevelConverged = "progressive.level_converged";  // before settling_failed
 constexpr const char* kSettlingFailed = "progressive.settling_failed";
 
+/// The shells and colliders of `system` as named parts, for intersection listings.
+std::vector<TrianglePart> triangle_parts(const ShellSystem& system) {
+  std::vector<TrianglePart> parts;
+  for (const ShellBlock& shell : system.shells())
+    parts.push_back({fmt::format("shell '{}'", shell.name), shell.first_triangle,
+                     shell.triangle_count});
+  for (const ColliderBlock& collider : system.colliders())
+    parts.push_back({fmt::format("collider '{}'", collider.name), collider.first_triangle,
+                     collider.triangle_count});
+  return parts;
+}
+
 void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
   const auto fail = [&](const std::string& what) {
     throw InputError(fmt::format("{}: [hierarchy] {}", scene.source.string(), what));
@@ -39,16 +53,11 @@ void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
   if (s.refine_frame && (*s.refine_frame < 1 || *s.refine_frame > scene.time.frames))
     fail(fmt::format("refine_frame must be a frame in 1..{} (got {})", scene.time.frames,
                      *s.refine_frame));
-  if (!scene.colliders.empty() || scene.contact.enabled.value_or(false) ||
-      scene.contact.self_contact)
+  if (strain_limit_enabled(scene) && s.levels > 1)
     fail(
-        "progressive simulation handles scenes without contact only (no [[collider]], "
-        "[contact] off); contact-safe refinement is not implemented yet");
-  if (strain_limit_enabled(scene))
-    fail(
-        "progressive simulation handles scenes without strain limits only (no 'strain_limit' "
-        "in a shell's material); the level proxies do not carry the barrier yet, so run such "
-        "scenes with levels = 1");
+        "levels > 1 with a strain limit ('strain_limit' in a shell's material): the refinement "
+        "does not yet make its initializer strictly feasible (paper §4.4.5), so run such scenes "
+        "with levels = 1");
   if (settings.max_settle_steps < 1)
     fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
 }
@@ -104,6 +113,18 @@ void ProgressiveSimulation::initialize() {
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
+  if (contact_enabled(scene))
+    for (int level = level_count_ - 1; level >= 0; --level) {
+      enter_level(level);
+      require_intersection_free(
+          level_system().rest_mesh(),
+          level + 1 == level_count_
+              ? std::string("the rest state")
+              : fmt::format("level {} of {} of the hierarchy (decimated rest state; use fewer "
+                            "[hierarchy] levels or a larger vertex_ratio)",
+                            level, level_count_),
+          triangle_parts(level_system()));
+    }
   enter_level(0);
   x_ = flat(level_system().rest_mesh().vertices);
   previous_ = x_;
@@ -124,9 +145,42 @@ void ProgressiveSimulation::build_prolongations() {
                                        : ShellProlongation(rest, h.levels[here].next_finer,
                                                            h.levels[next].rest.vertices));
     }
-    to_finest_.emplace_back(std::move(finest_maps));
-    to_next_.emplace_back(std::move(next_maps));
+    const int collider_vertices =
+        finest_.rest_mesh().vertex_count() -
+        (finest_.colliders().empty() ? finest_.rest_mesh().vertex_count()
+                                     : finest_.colliders().front().first_vertex);
+    to_finest_.emplace_back(std::move(finest_maps), collider_vertices);
+    to_next_.emplace_back(std::move(next_maps), collider_vertices);
   }
+}
+
+ProgressiveSimulation::Expansion ProgressiveSimulation::system_expansion(int level) const {
+  Expansion expansion;
+  int coarse_first = 0;
+  for (const MeshHierarchy& h : hierarchies_) {
+    const int here = shell_level(h, level, level_count_);
+    const int next = shell_level(h, level + 1, level_count_);
+    const int coarse_count = h.levels[here].rest.vertex_count();
+    const int fine_count = h.levels[next].rest.vertex_count();
+    if (next != here && (static_cast<int>(h.levels[here].parent.size()) != fine_count ||
+                         static_cast<int>(h.levels[here].expansion_color.size()) != coarse_count))
+      throw std::invalid_argument(fmt::format(
+          "ProgressiveSimulation: level {} of shell '{}' has no parents or expansion colours for "
+          "the safe refinement",
+          here, finest_.shells()[&h - hierarchies_.data()].name));
+    for (int v = 0; v < fine_count; ++v)
+      expansion.parent.push_back(coarse_first + (next == here ? v : h.levels[here].parent[v]));
+    for (int k = 0; k < coarse_count; ++k)
+      expansion.color.push_back(next == here ? 0 : h.levels[here].expansion_color[k]);
+    coarse_first += coarse_count;
+  }
+  // Colliders keep their mesh at every level.
+  for (const ColliderBlock& collider : finest_.colliders())
+    for (int v = 0; v < collider.vertex_count; ++v) {
+      expansion.parent.push_back(coarse_first++);
+      expansion.color.push_back(0);
+    }
+  return expansion;
 }
 
 NewtonSettings ProgressiveSimulation::level_newton_settings(int level) const {
@@ -149,7 +203,7 @@ void ProgressiveSimulation::enter_level(int level) {
   if (level + 1 == level_count_) {
     coarse_system_.reset();
     stepper_ = std::make_unique<LevelStepper>(
-        finest_, std::make_unique<DirectObjective>(finest_, scene.time.step),
+        finest_, std::make_unique<LevelObjective>(finest_, scene.time.step),
         level_newton_settings(level));
   } else {
     std::vector<LevelShellMesh> shells;
@@ -205,10 +259,12 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   const int iterations_done = std::exchange(resumed_iterations_, 0);
   if (iterations_done == 0) previous_ = x_;
+  if (!out.settling && iterations_done == 0) frame_start_ = previous_;
   out.frame = stepper_->step(previous_, x_, frame, time_step, iterations_done,
                              [&](const NewtonIteration& it) {
                                if (progress) progress(level_, frame, it);
-                             });
+                             },
+                             frame_start_);
   out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
   const bool converged_at_start = out.frame.newton.converged && out.frame.newton.iterations == 0;
@@ -236,18 +292,30 @@ void ProgressiveSimulation::refine() {
     throw std::logic_error(
         fmt::format("ProgressiveSimulation::refine: level {} is not done", level_));
   Eigen::VectorXd next = to_next_[level_].apply(x_);
+  const Eigen::VectorXd coarse = x_;
+  const bool contact = contact_enabled(finest_.scene());
+  const Expansion expansion = contact ? system_expansion(level_) : Expansion{};
   enter_level(level_ + 1);
   level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
+  if (contact) {
+    RefinementStats stats;
+    next = safe_initialize(level_system(), expansion.parent, expansion.color, coarse, next,
+                           level_, stats);
+    refinements_.push_back(stats);
+  }
   x_ = std::move(next);
   previous_ = x_;
+  frame_start_ = x_;
 }
 
 std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
-  return {{kFramesDone, frame_},
-          {kSettleSteps, settle_steps_},
-          {kSettleGrowth, settle_growth_},
-          {kSettled, settled_ ? 1.0 : 0.0},
-          {kSettlingFailed, settling_failed_ ? 1.0 : 0.0}};
+  std::map<std::string, double> state{{kFramesDone, frame_},
+                                      {kSettleSteps, settle_steps_},
+                                      {kSettleGrowth, settle_growth_},
+                                      {kSettled, settled_ ? 1.0 : 0.0},
+                                      {kSettlingFailed, settling_failed_ ? 1.0 : 0.0}};
+  stepper_->frame_solver().save_state(state);
+  return state;
 }
 
 void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd& positions,
@@ -274,6 +342,8 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
         level, size, positions.size(), previous.size()));
   x_ = positions;
   previous_ = previous;
+  frame_start_ = previous;
+  stepper_->frame_solver().load_state(schedule_state);
   const auto stored = [&](const char* name) -> std::optional<double> {
     const auto found = schedule_state.find(name);
     if (found == schedule_state.end()) return std::nullopt;

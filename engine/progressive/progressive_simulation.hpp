@@ -1,6 +1,5 @@
 #pragma once
-// Progressive quasistatic simulation (paper §3, §4.5; DESIGN.md §6) of scenes without contact:
-// previews at the coarsest level over the loading script, then refinement level by level at the
+// Progressive quasistatic simulation (paper §3, §4.4–4.5; DESIGN.md §6): previews at the coarsest level over the loading script, then refinement level by level at the
 // refine frame, and the true objective at the finest level to convergence.
 //
 // Schedule, one quasistatic step per call of step():
@@ -8,14 +7,19 @@
 //     preview_iterations Newton-type iterations per step; then "settling" steps at the refine
 //     frame (loading held, xᵗ ← x each step) until a step changes the solution by
 //     ‖x − xᵗ‖∞/Δt < preview_tolerance;
-//   refine(): x_{l+1} = P^l_{l+1}(x_l) with the pinned vertices set exactly (no contact: the
-//     target is the initializer);
+//   refine(): the target P^l_{l+1}(x_l) with the pinned vertices at their scripted positions;
+//     without contact it is the initializer, with contact safe_initialize (safe_refinement.hpp)
+//     expands x_l toward it without intersecting;
 //   intermediate levels: settling steps at the refine frame as above;
 //   finest level: settling steps with the true incremental potential, each solved to the
 //     scene's tolerance, until the change is below that tolerance; then frames
 //     refine_frame+1..frames, each one converged step and (the scene's frame_solution =
 //     equilibrium) its settling steps.
 // With levels = 1 the finest level steps frames 1..frames as QuasistaticSimulation does.
+// With contact (and friction) every level steps its own meshes and the colliders with the
+// level's barrier, CCD line search and κ adaptation (FrameSolver), so every state of every level
+// is free of intersections. A step of a settling sequence moves no pins; its frame solver only
+// raises κ to the balance at its start when that is higher.
 
 #include <filesystem>
 #include <functional>
@@ -27,6 +31,7 @@
 #include "engine/hierarchy/mesh_hierarchy.hpp"
 #include "engine/progressive/level_stepper.hpp"
 #include "engine/progressive/proxy_objective.hpp"
+#include "engine/progressive/safe_refinement.hpp"
 #include "engine/progressive/system_prolongation.hpp"
 
 namespace psq {
@@ -102,6 +107,8 @@ class ProgressiveSimulation {
   [[nodiscard]] const ShellSystem& level_system() const;
   [[nodiscard]] const TriMesh& level_rest_mesh() const { return level_system().rest_mesh(); }
   [[nodiscard]] const std::vector<MeshHierarchy>& hierarchies() const { return hierarchies_; }
+  /// What each refinement's safe initialization did (contact scenes; in refinement order).
+  [[nodiscard]] const std::vector<RefinementStats>& refinements() const { return refinements_; }
 
   /// Current positions of the current level (flat, 3n).
   [[nodiscard]] const Eigen::VectorXd& positions() const { return x_; }
@@ -135,6 +142,13 @@ class ProgressiveSimulation {
   /// Validates the hierarchies, resolves the tolerances, enters level 0 at its rest state.
   void initialize();
   void build_prolongations();
+  /// Per level-(l+1) vertex of the system (shells, then colliders) its level-l parent, and per
+  /// level-l vertex its expansion colour: the shells' hierarchies renumbered into the systems.
+  struct Expansion {
+    std::vector<int> parent;
+    std::vector<int> color;
+  };
+  [[nodiscard]] Expansion system_expansion(int level) const;
   /// Makes `level` the current level (its system, objective and stepper).
   void enter_level(int level);
   [[nodiscard]] NewtonSettings level_newton_settings(int level) const;
@@ -150,6 +164,7 @@ class ProgressiveSimulation {
   /// Per level below the finest: P^l (to the finest mesh) and P^l_{l+1} (to the next level).
   std::vector<SystemProlongation> to_finest_;
   std::vector<SystemProlongation> to_next_;
+  std::vector<RefinementStats> refinements_;
 
   int level_ = 0;
   int frame_ = 0;
@@ -166,6 +181,8 @@ class ProgressiveSimulation {
   std::unique_ptr<LevelStepper> stepper_;
   Eigen::VectorXd x_;
   Eigen::VectorXd previous_;
+  /// The current frame's first xᵗ: friction's slip is measured from it through its settling.
+  Eigen::VectorXd frame_start_;
 };
 
 }  // namespace psq

@@ -25,20 +25,14 @@ double bending_stiffening(const ShellBlock& level, const ShellBlock& finest) {
 
 }  // namespace
 
-ProxyObjective::ProxyObjective(const ShellSystem& level, const ShellSystem& finest,
-                               const SystemProlongation& to_finest, double time_step,
-                               ProxyGradient gradient)
-    : level_(level),
-      finest_(finest),
-      to_finest_(to_finest),
-      inertia_weight_(1.0 / (time_step * time_step)),
-      gradient_kind_(gradient),
-      previous_(flat(level.rest_mesh().vertices)) {
+ProxyElastics::ProxyElastics(const ShellSystem& level, const ShellSystem& finest,
+                             const SystemProlongation& to_finest, ProxyGradient gradient)
+    : level_(level), finest_(finest), to_finest_(to_finest), gradient_kind_(gradient) {
   for (std::size_t s = 0; s < level.shells().size(); ++s)
     bending_scale_.push_back(bending_stiffening(level.shells()[s], finest.shells()[s]));
 }
 
-ProxyObjective::FineEvaluation& ProxyObjective::at(const Eigen::VectorXd& x) const {
+ProxyElastics::FineEvaluation& ProxyElastics::at(const Eigen::VectorXd& x) const {
   const bool hit = memo_.x.size() > 0 && x.size() == memo_.x.size() &&
                    std::memcmp(x.data(), memo_.x.data(),
                                sizeof(double) * static_cast<std::size_t>(x.size())) == 0;
@@ -50,39 +44,35 @@ ProxyObjective::FineEvaluation& ProxyObjective::at(const Eigen::VectorXd& x) con
   return memo_;
 }
 
-double ProxyObjective::elastic_at(FineEvaluation& fine) const {
+double ProxyElastics::elastic_at(FineEvaluation& fine) const {
   if (!fine.elastic) fine.elastic = fine_elastics(finest_, fine.prolonged);
   return *fine.elastic;
 }
 
-double ProxyObjective::elastic_energy(const Eigen::VectorXd& x) const {
+double ProxyElastics::elastic_energy(const Eigen::VectorXd& x) const {
   return elastic_at(at(x));
 }
 
-double ProxyObjective::value(const Eigen::VectorXd& x) {
-  const Eigen::VectorXd dx = x - previous_;
-  const double inertia = 0.5 * inertia_weight_ * dx.dot(level_.dof_masses().cwiseProduct(dx));
+double ProxyElastics::energy(const Eigen::VectorXd& x) const {
   FineEvaluation& fine = at(x);
-  return inertia + elastic_at(fine) - finest_.external_force().dot(fine.prolonged);
+  return elastic_at(fine) - finest_.external_force().dot(fine.prolonged);
 }
 
-void ProxyObjective::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+void ProxyElastics::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const {
   const Eigen::VectorXd& fine = at(x).prolonged;
   Eigen::VectorXd fine_g = -finest_.external_force();
   for (const auto& m : finest_.membranes()) m.add_gradient(fine, fine_g);
   for (const auto& b : finest_.bendings()) b.add_gradient(fine, fine_g);
-  g = inertia_weight_ * level_.dof_masses().cwiseProduct(x - previous_) +
-      (gradient_kind_ == ProxyGradient::exact ? to_finest_.apply_jacobian_transpose(x, fine_g)
-                                              : to_finest_.apply_linear_transpose(fine_g));
+  g += gradient_kind_ == ProxyGradient::exact ? to_finest_.apply_jacobian_transpose(x, fine_g)
+                                              : to_finest_.apply_linear_transpose(fine_g);
 }
 
-void ProxyObjective::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
-  H.diagonal = inertia_weight_ * level_.dof_masses();
+void ProxyElastics::hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches) const {
   const std::size_t shells = level_.membranes().size();
-  H.batches.resize(2 * shells);
+  batches.resize(2 * shells);
   for (std::size_t s = 0; s < shells; ++s) {
-    level_.membranes()[s].hessian(x, H.batches[2 * s]);
-    ElementMatrices& bending = H.batches[2 * s + 1];
+    level_.membranes()[s].hessian(x, batches[2 * s]);
+    ElementMatrices& bending = batches[2 * s + 1];
     level_.bendings()[s].hessian(x, bending);
     Eigen::Map<Eigen::VectorXd>(bending.values.data(),
                                 static_cast<Eigen::Index>(bending.values.size())) *= bending_scale_[s];

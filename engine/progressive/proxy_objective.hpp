@@ -1,9 +1,11 @@
 #pragma once
 // The coarse-level proxy of the fine incremental potential (paper eqs. 2–3, §4.5):
-//   F(x_l) = 1/(2Δt²)‖x_l − x_lᵗ‖²_{M_l} + Ψ_L(P^l(x_l)) − f_L·P^l(x_l),
+//   F(x_l) = 1/(2Δt²)‖x_l − x_lᵗ‖²_{M_l} + Ψ_L(P^l(x_l)) − f_L·P^l(x_l) + C_l(x_l),
 // fine-scale elastics Ψ_L and external force f_L evaluated through the direct prolongation P^l,
-// level-l masses M_l. Newton-type steps use the exact gradient or the paper's eq.-10 gradient
-// with the offsets held, and level l's own projected Hessian as preconditioner,
+// level-l masses M_l, and C_l the level's own contact, friction and strain-limit terms (added to
+// its incremental potential like at the finest level). Newton-type steps use the exact gradient
+// or the paper's eq.-10 gradient with the offsets held, and level l's own projected Hessian as
+// preconditioner,
 //   H(x_l) = M_l/Δt² + PSD(∇²E_membrane,l(x_l)) + s_l·PSD(∇²E_bending,l(x_l)),
 // its bending part scaled by s_l, about how much stiffer the fine bending through P^l is
 // (√(fine / level triangles), the coarse/fine edge-length ratio): without it the steps
@@ -11,6 +13,7 @@
 
 #include "engine/progressive/level_objective.hpp"
 #include "engine/progressive/system_prolongation.hpp"
+#include "engine/sim/elastic_model.hpp"
 #include "engine/sim/shell_system.hpp"
 
 #include <optional>
@@ -18,32 +21,28 @@
 
 namespace psq {
 
-/// Which gradient ProxyObjective::gradient returns.
+/// Which gradient ProxyElastics::add_gradient adds.
 enum class ProxyGradient {
-  /// M_l(x − xᵗ)/Δt² + Uᵀ(∇Ψ_L − f_L)(P(x)): the prolongation's offsets held at their current
-  /// value (paper eq. 10). Not the gradient of F: the line search sees F itself.
+  /// Uᵀ(∇Ψ_L − f_L)(P(x)): the prolongation's offsets held at their current value (paper
+  /// eq. 10). Not the gradient of F: the line search sees F itself.
   held_offsets,
-  /// M_l(x − xᵗ)/Δt² + (∂P/∂x)ᵀ(∇Ψ_L − f_L)(P(x)): the gradient of F.
+  /// (∂P/∂x)ᵀ(∇Ψ_L − f_L)(P(x)): the gradient of F.
   exact,
 };
 
-class ProxyObjective : public LevelObjective {
+/// Ψ_L(P^l(x)) − f_L·P^l(x) with the level's scaled Hessian blocks.
+class ProxyElastics : public ElasticModel {
  public:
-  /// `level`: the level's system (masses, pins, elastics for the preconditioner); `finest`: the
-  /// finest system (elastics and external force of the proxy); `to_finest`: P^l. All three are
-  /// referenced, not copied.
-  ProxyObjective(const ShellSystem& level, const ShellSystem& finest,
-                 const SystemProlongation& to_finest, double time_step, ProxyGradient gradient);
+  /// `level`: the level's system (elastics for the preconditioner); `finest`: the finest system
+  /// (elastics and external force of the proxy); `to_finest`: P^l. All three are referenced.
+  ProxyElastics(const ShellSystem& level, const ShellSystem& finest,
+                const SystemProlongation& to_finest, ProxyGradient gradient);
 
-  void set_previous(const Eigen::VectorXd& previous) override { previous_ = previous; }
-  void set_time_step(double time_step) override { inertia_weight_ = 1.0 / (time_step * time_step); }
   /// Ψ_L(P^l(x)).
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override;
-
-  [[nodiscard]] Eigen::Index size() const override { return previous_.size(); }
-  double value(const Eigen::VectorXd& x) override;
-  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
-  void hessian(const Eigen::VectorXd& x, HessianBlocks& H) override;
+  [[nodiscard]] double energy(const Eigen::VectorXd& x) const override;
+  void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const override;
+  void hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches) const override;
 
  private:
   /// What the proxy knows at one coarse x, independent of xᵗ and Δt. Filled lazily and
@@ -55,9 +54,9 @@ class ProxyObjective : public LevelObjective {
   /// not kept: it is seldom asked twice at one x (kept, the gradient evaluations were 51 → 51,
   /// 30 → 29, 22 → 20).
   struct FineEvaluation {
-    Eigen::VectorXd x;                       ///< the key, compared bitwise
-    Eigen::VectorXd prolonged;               ///< P^l(x)
-    std::optional<double> elastic;           ///< Ψ_L(P^l(x))
+    Eigen::VectorXd x;              ///< the key, compared bitwise
+    Eigen::VectorXd prolonged;      ///< P^l(x)
+    std::optional<double> elastic;  ///< Ψ_L(P^l(x))
   };
   /// The evaluation at x, reset (with P^l(x) computed) when x differs from the remembered one.
   /// A non-finite x, which apply() rejects, is never remembered.
@@ -67,11 +66,18 @@ class ProxyObjective : public LevelObjective {
   const ShellSystem& level_;
   const ShellSystem& finest_;
   const SystemProlongation& to_finest_;
-  double inertia_weight_;  ///< 1/Δt²
   std::vector<double> bending_scale_;  ///< s_l per shell
   ProxyGradient gradient_kind_;
-  Eigen::VectorXd previous_;
-  mutable FineEvaluation memo_;  // mutable so that the const elastic_energy() shares it
+  mutable FineEvaluation memo_;  // mutable so that the const evaluations share it
+};
+
+/// F(x_l): the level's incremental potential with ProxyElastics as its elastic part.
+class ProxyObjective : public LevelObjective {
+ public:
+  ProxyObjective(const ShellSystem& level, const ShellSystem& finest,
+                 const SystemProlongation& to_finest, double time_step, ProxyGradient gradient)
+      : LevelObjective(level, time_step,
+                       std::make_unique<ProxyElastics>(level, finest, to_finest, gradient)) {}
 };
 
 }  // namespace psq

@@ -30,7 +30,9 @@ ShellProlongation identity_prolongation(const TriMesh& rest) {
   return ShellProlongation(rest, std::move(locations), rest.vertices);
 }
 
-SystemProlongation::SystemProlongation(std::vector<ShellProlongation> shells) {
+SystemProlongation::SystemProlongation(std::vector<ShellProlongation> shells,
+                                       int collider_vertices)
+    : collider_vertices_(collider_vertices) {
   for (ShellProlongation& map : shells) {
     const int coarse = map.coarse_vertex_count();
     const int targets = map.target_count();
@@ -38,6 +40,16 @@ SystemProlongation::SystemProlongation(std::vector<ShellProlongation> shells) {
     coarse_vertices_ += coarse;
     target_vertices_ += targets;
   }
+  shell_coarse_vertices_ = coarse_vertices_;
+  shell_target_vertices_ = target_vertices_;
+  coarse_vertices_ += collider_vertices;
+  target_vertices_ += collider_vertices;
+}
+
+void SystemProlongation::copy_colliders(const Eigen::VectorXd& from, int from_first,
+                                        Eigen::VectorXd& to, int to_first) const {
+  const Eigen::Index count = 3 * Eigen::Index(collider_vertices_);
+  to.segment(3 * Eigen::Index(to_first), count) = from.segment(3 * Eigen::Index(from_first), count);
 }
 
 Eigen::VectorXd SystemProlongation::apply(const Eigen::VectorXd& coarse) const {
@@ -47,6 +59,7 @@ Eigen::VectorXd SystemProlongation::apply(const Eigen::VectorXd& coarse) const {
         b.map.apply(block_rows(coarse, b.first_coarse, b.map.coarse_vertex_count()));
     out.segment(3 * Eigen::Index(b.first_target), prolonged.size()) = flat(prolonged);
   }
+  copy_colliders(coarse, shell_coarse_vertices_, out, shell_target_vertices_);
   return out;
 }
 
@@ -58,6 +71,7 @@ Eigen::VectorXd SystemProlongation::apply_linear_transpose(const Eigen::VectorXd
     out.segment(3 * Eigen::Index(b.first_coarse), cols) =
         b.map.linear_part().transpose() * g.segment(3 * Eigen::Index(b.first_target), rows);
   }
+  copy_colliders(g, shell_target_vertices_, out, shell_coarse_vertices_);
   return out;
 }
 
@@ -71,6 +85,7 @@ Eigen::VectorXd SystemProlongation::apply_jacobian_transpose(const Eigen::Vector
     out.segment(3 * Eigen::Index(b.first_coarse), cols) = b.map.apply_jacobian_transpose(
         shell_coarse, g.segment(3 * Eigen::Index(b.first_target), rows));
   }
+  copy_colliders(g, shell_target_vertices_, out, shell_coarse_vertices_);
   return out;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Prolongation of a whole multi-shell system: the shells are concatenated into one vertex array
 // (ShellSystem), and each shell is prolonged by its own ShellProlongation on its blocks of the
-// coarse and target arrays.
+// coarse and target arrays. The colliders' vertices follow the shells' in both arrays (they keep
+// their mesh at every level) and are copied.
 
 #include <Eigen/Core>
 #include <vector>
@@ -16,8 +17,9 @@ ShellProlongation identity_prolongation(const TriMesh& rest);
 
 class SystemProlongation {
  public:
-  /// One map per shell, in the shells' order in the concatenated arrays.
-  explicit SystemProlongation(std::vector<ShellProlongation> shells);
+  /// One map per shell, in the shells' order in the concatenated arrays, then
+  /// `collider_vertices` copied vertices.
+  explicit SystemProlongation(std::vector<ShellProlongation> shells, int collider_vertices = 0);
 
   [[nodiscard]] Eigen::Index coarse_size() const { return 3 * Eigen::Index(coarse_vertices_); }
   [[nodiscard]] Eigen::Index target_size() const { return 3 * Eigen::Index(target_vertices_); }
@@ -36,7 +38,15 @@ class SystemProlongation {
     int first_coarse;  ///< first vertex of this shell in the coarse array
     int first_target;  ///< first vertex of this shell in the target array
   };
+  /// Copies the collider rows of `from` (after its first `from_first` vertices) into those of
+  /// `to` (after `to_first`).
+  void copy_colliders(const Eigen::VectorXd& from, int from_first, Eigen::VectorXd& to,
+                      int to_first) const;
+
   std::vector<Block> blocks_;
+  int collider_vertices_ = 0;
+  int shell_coarse_vertices_ = 0;  ///< the colliders' first vertex in the coarse array
+  int shell_target_vertices_ = 0;  ///< the colliders' first vertex in the target array
   int coarse_vertices_ = 0;
   int target_vertices_ = 0;
 };

@@ -25,7 +25,7 @@ inline DirectRun settled_direct_run(const ShellSystem& system, double tolerance,
   newton.step_scale = scene.time.step;
   newton.tolerance = tolerance;
   newton.max_iterations = scene.solver.max_iterations;
-  LevelStepper stepper(system, std::make_unique<DirectObjective>(system, scene.time.step), newton);
+  LevelStepper stepper(system, std::make_unique<LevelObjective>(system, scene.time.step), newton);
   DirectRun run;
   run.positions = flat(system.rest_mesh().vertices);
   for (int frame = 1; frame <= scene.time.frames; ++frame)

@@ -1,0 +1,323 @@
+#include "engine/progressive/safe_refinement.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <set>
+
+#include "engine/contact/additive_ccd.hpp"
+#include "engine/contact/broad_phase.hpp"
+#include "engine/contact/edge_edge_distance.hpp"
+#include "engine/contact/intersection_check.hpp"
+#include "engine/contact/point_triangle_distance.hpp"
+#include "engine/core/error.hpp"
+#include "engine/sim/contact_term.hpp"
+
+namespace psq {
+namespace {
+
+/// The first perturbation moves a cluster's farthest child by g/kPerturbationDivisor: an order
+/// of magnitude below the gap (§4.4.2), so that only the patch itself can intersect.
+constexpr double kPerturbationDivisor = 10.0;
+/// Random rotations tried per cluster after the first perturbation intersects.
+constexpr int kMaxPerturbationTries = 64;
+/// ACCD ratio bounds (§4.4.2): pairs closer than g keep 99.9 % of their gap, others 10 %.
+constexpr double kCloseRatioBound = 0.999;
+constexpr double kFarRatioBound = 0.1;
+/// Additive CCD rounds per advance; each round stops at least one pair's vertices, so the cap
+/// only ends advances whose limiting pairs keep changing.
+constexpr int kMaxAdvanceRounds = 200;
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+Eigen::Vector3d row(const Positions& p, int v) { return p.row(v).transpose(); }
+
+/// The level-(l+1) surface with some clusters not yet expanded: each fine vertex is represented
+/// by itself once expanded, else by its cluster's first child; triangles and edges whose
+/// representatives coincide are dropped, duplicates merged, and the vertices renumbered.
+struct MixedMesh {
+  std::vector<int> fine_vertex;  ///< per mixed vertex: the fine vertex it is
+  Triangles triangles;
+  std::vector<std::array<int, 2>> edges;
+  std::vector<int> body;
+  std::vector<int> triangle_body;
+
+  MixedMesh(const ContactSurface& surface, const std::vector<int>& representative) {
+    const int n = static_cast<int>(representative.size());
+    std::vector<int> mixed(n, -1);
+    const auto index = [&](int v) {
+      const int r = representative[v];
+      if (mixed[r] < 0) {
+        mixed[r] = static_cast<int>(fine_vertex.size());
+        fine_vertex.push_back(r);
+      }
+      return mixed[r];
+    };
+    std::set<std::array<int, 3>> seen_triangles;
+    std::vector<std::array<int, 3>> kept;
+    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
+      const std::array<int, 3> r{representative[surface.triangles(t, 0)],
+                                 representative[surface.triangles(t, 1)],
+                                 representative[surface.triangles(t, 2)]};
+      if (r[0] == r[1] || r[1] == r[2] || r[0] == r[2]) continue;
+      std::array<int, 3> key = r;
+      std::sort(key.begin(), key.end());
+      if (!seen_triangles.insert(key).second) continue;
+      kept.push_back({index(surface.triangles(t, 0)), index(surface.triangles(t, 1)),
+                      index(surface.triangles(t, 2))});
+    }
+    std::set<std::array<int, 2>> seen_edges;
+    for (const auto& e : surface.edges) {
+      const int a = representative[e[0]], b = representative[e[1]];
+      if (a == b || !seen_edges.insert({std::min(a, b), std::max(a, b)}).second) continue;
+      edges.push_back({index(e[0]), index(e[1])});
+    }
+    triangles.resize(static_cast<Eigen::Index>(kept.size()), 3);
+    for (std::size_t t = 0; t < kept.size(); ++t)
+      for (int k = 0; k < 3; ++k) triangles(static_cast<Eigen::Index>(t), k) = kept[t][k];
+    for (int v : fine_vertex) body.push_back(surface.vertex_body[v]);
+    for (const auto& t : kept) triangle_body.push_back(body[t[0]]);
+  }
+
+  [[nodiscard]] Positions positions(const Positions& fine) const {
+    Positions p(static_cast<Eigen::Index>(fine_vertex.size()), 3);
+    for (std::size_t m = 0; m < fine_vertex.size(); ++m)
+      p.row(static_cast<Eigen::Index>(m)) = fine.row(fine_vertex[m]);
+    return p;
+  }
+};
+
+/// The fine vertices of the triangles that intersect (pairs of bodies that may touch) or are
+/// degenerate in the mixed mesh at y; empty when it is clean.
+std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& y,
+                                       const BodyPairRule& may_touch) {
+  const Positions p = mesh.positions(y);
+  const IntersectionReport report = find_intersections(p, mesh.triangles);
+  std::vector<int> vertices;
+  const auto add_triangle = [&](int t) {
+    for (int k = 0; k < 3; ++k) vertices.push_back(mesh.fine_vertex[mesh.triangles(t, k)]);
+  };
+  for (const auto& [a, b] : report.intersecting_pairs) {
+    if (!may_touch(mesh.triangle_body[a], mesh.triangle_body[b])) continue;
+    add_triangle(a);
+    add_triangle(b);
+  }
+  for (int t : report.degenerate_triangles) add_triangle(t);
+  return vertices;
+}
+
+/// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
+/// displacements `delta` (rows per fine vertex; zero rows stay): rounds of ACCD over the swept
+/// candidates, each moving all by the smallest safe fraction and then stopping the vertices of
+/// the limiting pairs. y is updated; returns the rounds taken.
+int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const AdditiveCcdSettings& ccd,
+            double gap, Positions& y, Positions delta) {
+  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+  Positions p = mesh.positions(y);
+  Positions d = mesh.positions(delta);
+  int rounds = 0;
+  for (; rounds < kMaxAdvanceRounds && !d.isZero(0.0); ++rounds) {
+    const Positions end = p + d;
+    const ContactCandidates candidates = broad.swept_candidates(p, end, ccd.min_distance);
+    const auto moving = [&](std::initializer_list<int> vertices) {
+      for (int v : vertices)
+        if (!d.row(v).isZero(0.0)) return true;
+      return false;
+    };
+    const std::size_t pt = candidates.point_triangle.size();
+    // Point–triangle candidates first, then edge–edge: (p, t0, t1, t2) or (a0, a1, b0, b1).
+    const auto pair_vertices = [&](std::size_t i) -> std::array<int, 4> {
+      if (i < pt) {
+        const auto& c = candidates.point_triangle[i];
+        return {c.vertex, broad.triangles()(c.triangle, 0), broad.triangles()(c.triangle, 1),
+                broad.triangles()(c.triangle, 2)};
+      }
+      const auto& c = candidates.edge_edge[i - pt];
+      return {broad.edges()[c.edge0][0], broad.edges()[c.edge0][1], broad.edges()[c.edge1][0],
+              broad.edges()[c.edge1][1]};
+    };
+    std::vector<double> toi(candidates.size(), 1.0);
+    tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
+      PairPositions start, stop;
+      const bool point_triangle = i < pt;
+      const std::array<int, 4> v = pair_vertices(i);
+      if (!moving({v[0], v[1], v[2], v[3]})) return;
+      for (int k = 0; k < 4; ++k) {
+        start[k] = row(p, v[k]);
+        stop[k] = row(end, v[k]);
+      }
+      const double d0 =
+          std::sqrt(point_triangle ? point_triangle_distance(start[0], start[1], start[2], start[3])
+                                   : edge_edge_distance(start[0], start[1], start[2], start[3]));
+      AdditiveCcdSettings settings = ccd;
+      settings.ratio_bound = d0 - ccd.min_distance < gap ? kCloseRatioBound : kFarRatioBound;
+      const CcdResult result = point_triangle ? point_triangle_ccd(start, stop, settings)
+                                              : edge_edge_ccd(start, stop, settings);
+      if (result.collision) toi[i] = result.toi;
+    });
+    const double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
+    p += alpha * d;
+    if (alpha >= 1.0) break;
+    d *= 1.0 - alpha;
+    for (std::size_t i = 0; i < toi.size(); ++i) {
+      if (toi[i] > alpha) continue;
+      for (int k : pair_vertices(i)) d.row(k).setZero();
+    }
+  }
+  for (std::size_t m = 0; m < mesh.fine_vertex.size(); ++m)
+    y.row(mesh.fine_vertex[m]) = p.row(static_cast<Eigen::Index>(m));
+  return rounds;
+}
+
+/// The smallest distance between primitives of the mixed mesh at y that may touch, capped at
+/// `cap`.
+double mixed_gap(const MixedMesh& mesh, const BodyPairRule& may_touch, const Positions& y,
+                 double cap) {
+  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+  return broad.clearance(mesh.positions(y), 0.0, cap);
+}
+
+}  // namespace
+
+Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
+                                const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
+                                const Eigen::VectorXd& target, int level,
+                                RefinementStats& stats) {
+  const Clock::time_point start = Clock::now();
+  stats = RefinementStats{};
+  stats.level = level;
+  const ContactSurface surface = contact_surface(fine, fine.scene().contact.self_contact);
+  const ContactParameters parameters = contact_parameters(fine);
+  AdditiveCcdSettings ccd = parameters.ccd;
+  ccd.min_distance = parameters.band.thickness;
+  const double cap = parameters.band.thickness + parameters.band.activation_distance;
+  const int n = static_cast<int>(parent.size());
+  const int coarse_count = static_cast<int>(color.size());
+  const Eigen::Map<const Positions> coarse = as_positions(coarse_x);
+  const Eigen::Map<const Positions> goal = as_positions(target);
+
+  std::vector<std::vector<int>> children(coarse_count);
+  for (int v = 0; v < n; ++v) children[parent[v]].push_back(v);
+  Positions y(n, 3);
+  std::vector<int> representative(n);
+  for (int v = 0; v < n; ++v) {
+    y.row(v) = coarse.row(parent[v]);
+    representative[v] = children[parent[v]].front();
+  }
+  const auto expand = [&](int k) {
+    for (int v : children[k]) representative[v] = v;
+  };
+  std::map<int, std::vector<int>> batches;  // colour → clusters of two or more children
+  for (int k = 0; k < coarse_count; ++k) {
+    if (children[k].size() > 1)
+      batches[color[k]].push_back(k);
+    else
+      expand(k);
+  }
+
+  // The children of k at parent + s·R·(target − parent), the farthest at `radius`.
+  const auto perturb = [&](int k, const Eigen::Matrix3d& rotation, double radius) {
+    const Eigen::Vector3d centre = row(coarse, k);
+    double farthest = 0.0;
+    for (int v : children[k]) farthest = std::max(farthest, (row(goal, v) - centre).norm());
+    const double scale = farthest > 0.0 ? radius / farthest : 0.0;
+    for (int v : children[k])
+      y.row(v) = (centre + scale * (rotation * (row(goal, v) - centre))).transpose();
+  };
+
+  stats.smallest_gap = std::numeric_limits<double>::infinity();
+  for (const auto& [batch_color, clusters] : batches) {
+    Clock::time_point phase = Clock::now();
+    const double gap = mixed_gap(MixedMesh(surface, representative), surface.may_touch, y, cap);
+    stats.gap_seconds += since(phase);
+    if (!(gap > ccd.min_distance))
+      throw NumericalError(fmt::format(
+          "refinement to level {}: the state being expanded has primitives {} m apart, at or "
+          "within the contact thickness, so no safe perturbation exists",
+          level, gap));
+    stats.smallest_gap = std::min(stats.smallest_gap, gap);
+    ++stats.batches;
+    stats.expansions += static_cast<int>(clusters.size());
+
+    phase = Clock::now();
+    const double radius = (gap - ccd.min_distance) / kPerturbationDivisor;
+    for (int k : clusters) {
+      expand(k);
+      perturb(k, Eigen::Matrix3d::Identity(), radius);
+    }
+    MixedMesh mixed(surface, representative);
+    std::set<int> failing;
+    for (int tries = 0;; ++tries) {
+      failing.clear();
+      for (int v : intersecting_vertices(mixed, y, surface.may_touch))
+        if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
+          failing.insert(parent[v]);
+      if (failing.empty()) break;
+      if (tries == kMaxPerturbationTries)
+        throw NumericalError(fmt::format(
+            "refinement to level {}: no intersection-free perturbation of the expansion of "
+            "level-{} vertex {} found in {} tries; use fewer levels or a smaller "
+            "[hierarchy] vertex_ratio step",
+            level, level - 1, *failing.begin(), kMaxPerturbationTries));
+      for (int k : failing) {
+        // Seeded by the level, the cluster and the try, so that a resumed run repeats it.
+        std::mt19937_64 random(static_cast<std::uint64_t>(level) * 1'000'003u +
+                               static_cast<std::uint64_t>(k) * 65'537u +
+                               static_cast<std::uint64_t>(tries));
+        std::normal_distribution<double> normal;
+        const Eigen::Quaterniond q(normal(random), normal(random), normal(random), normal(random));
+        perturb(k, q.normalized().toRotationMatrix(), radius);
+        ++stats.perturbation_retries;
+      }
+    }
+    stats.perturb_seconds += since(phase);
+
+    phase = Clock::now();
+    Positions delta = Positions::Zero(n, 3);
+    for (int k : clusters)
+      for (int v : children[k]) delta.row(v) = goal.row(v) - y.row(v);
+    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, gap, y, std::move(delta));
+    stats.ccd_seconds += since(phase);
+  }
+
+  // Every vertex the rest of the way, as far as it safely goes.
+  Clock::time_point phase = Clock::now();
+  const MixedMesh full(surface, representative);
+  const double gap = mixed_gap(full, surface.may_touch, y, cap);
+  if (!std::isfinite(stats.smallest_gap)) stats.smallest_gap = gap;
+  stats.gap_seconds += since(phase);
+  phase = Clock::now();
+  stats.ccd_rounds += advance(full, surface.may_touch, ccd, gap, y, goal - y);
+  stats.ccd_seconds += since(phase);
+
+  phase = Clock::now();
+  const std::vector<int> bad = intersecting_vertices(full, y, surface.may_touch);
+  if (!bad.empty())
+    throw NumericalError(fmt::format(
+        "refinement to level {}: the safe initialization ends intersecting at vertex {} (a bug: "
+        "every advance is CCD-checked)",
+        level, bad.front()));
+  stats.final_gap = mixed_gap(full, surface.may_touch, y, cap);
+  stats.check_seconds = since(phase);
+  double total = 0.0;
+  for (int v = 0; v < n; ++v) {
+    const double distance = (y.row(v) - goal.row(v)).norm();
+    stats.max_target_distance = std::max(stats.max_target_distance, distance);
+    total += distance;
+  }
+  stats.mean_target_distance = n > 0 ? total / n : 0.0;
+  stats.seconds = since(start);
+  return flat(y);
+}
+
+}  // namespace psq

@@ -1,0 +1,64 @@
+#pragma once
+// Safe initialization of a finer level from a coarser level's intersection-free state (paper
+// §4.4, DESIGN.md §6): the level-(l+1) mesh is expanded from x_l one colour of the expansion
+// colouring at a time, so that no state on the way intersects.
+//
+// Each level-(l+1) vertex starts at its parent's position: every coarse vertex is a cluster of
+// coincident children, and the surface is x_l itself ("mixed" meshes below: the level-(l+1)
+// triangles with the not yet expanded clusters merged into one vertex, whose images are the
+// level-l triangles). Per colour:
+//   1. g, the smallest distance between primitives of the current mixed mesh that may touch;
+//   2. every cluster of the colour is perturbed: its children move from the parent's position
+//      toward their prolonged targets by a common factor, the farthest by g/10. Every point of
+//      the new triangles is then within g/10 of the old surface, so only the expansion patch
+//      itself can intersect; the exact check decides, and a cluster whose patch intersects is
+//      tried again with its target layout turned by a random rotation (bounded tries);
+//   3. the colour's vertices advance toward their targets by additive CCD (ACCD with the
+//      per-pair ratio bound: 0.999 for a pair already closer than g, 0.1 otherwise). The
+//      advance is repeated: each round moves every vertex by the smallest safe fraction, then
+//      stops the vertices of the pairs that limited it, and the others go on (§4.4.4).
+// After the last colour every vertex advances toward its target the same way. The result is
+// checked once more with exact predicates; every step of the way is intersection-free by
+// construction, the final check is the independent judge.
+//
+// The colours come from the hierarchy (two clusters of one colour never share a level-(l+1)
+// triangle); the broad phase is built once per batch over the batch's whole motion.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "engine/sim/shell_system.hpp"
+
+namespace psq {
+
+/// What one refinement's safe initialization did.
+struct RefinementStats {
+  int level = 0;                  ///< the level refined into
+  int expansions = 0;             ///< coarse vertices split into two or more vertices
+  int batches = 0;                ///< colours with at least one expansion
+  int perturbation_retries = 0;   ///< cluster perturbations tried again after an intersection
+  int ccd_rounds = 0;             ///< additive CCD advances, all batches and the final one
+  double smallest_gap = 0.0;      ///< smallest g measured before a batch [m]
+  double final_gap = 0.0;         ///< smallest distance at the initializer (capped at d̂) [m]
+  double max_target_distance = 0.0;   ///< largest |initializer − prolonged target| of a vertex
+  double mean_target_distance = 0.0;  ///< mean of the same
+  double gap_seconds = 0.0;       ///< measuring g
+  double perturb_seconds = 0.0;   ///< perturbations and their exact checks
+  double ccd_seconds = 0.0;       ///< CCD advances
+  double check_seconds = 0.0;     ///< the final exact check
+  double seconds = 0.0;           ///< the whole initialization
+};
+
+/// The level-(l+1) initializer of `fine` (the level-(l+1) system, colliders included) from
+/// `coarse_x` (level l, intersection-free): `parent[v]` is the level-l vertex each level-(l+1)
+/// vertex collapsed into (a collider vertex: its own copy), `color[k]` the expansion colour of
+/// level-l vertex k, `target` the prolonged state P^l_{l+1}(x_l) with the pinned vertices at
+/// their scripted positions. `level` (l+1) names the level in messages and stats.
+/// @throws NumericalError naming the level and vertex when no intersection-free perturbation
+/// of a cluster is found, or when the final state fails the exact check.
+Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
+                                const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
+                                const Eigen::VectorXd& target, int level,
+                                RefinementStats& stats);
+
+}  // namespace psq

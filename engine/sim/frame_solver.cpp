@@ -1,0 +1,205 @@
+#include "engine/sim/frame_solver.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "engine/core/error.hpp"
+
+namespace psq {
+namespace {
+
+/// Penalty stiffness k of the first pull round, its growth per round and the rounds tried
+/// before a frame gives up on reaching its targets (the scripted vertices then stay where the
+/// last round left them, a safe state, and the next frame tries again).
+constexpr double kInitialPullStiffness = 1e4;
+constexpr double kPullGrowth = 100.0;
+constexpr int kMaxPullRounds = 6;
+
+/// With contact or strain limits, Newton runs in chunks of this many iterations with the κ and
+/// κ_s updates between them (the solver keeps its objective fixed within a call, so stiffnesses
+/// may only change between).
+constexpr int kStiffnessUpdateInterval = 10;
+
+/// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
+constexpr int kMaxFrictionIterations = 5;
+
+}  // namespace
+
+void append_solve(NewtonResult& frame, NewtonResult solve) {
+  const bool first = frame.history.empty();
+  solve.iterations += first ? 0 : frame.iterations;
+  solve.times += frame.times;
+  solve.wall_seconds += frame.wall_seconds;
+  solve.history.insert(solve.history.begin(), frame.history.begin(), frame.history.end());
+  frame = std::move(solve);
+}
+
+NewtonSolver::Progress numbered_through_frame(NewtonSolver::Progress progress, int& taken) {
+  if (!progress) return {};
+  return [progress = std::move(progress), &taken](const NewtonIteration& it) {
+    NewtonIteration numbered = it;
+    numbered.iteration = taken;
+    if (it.step_length > 0.0) ++taken;
+    progress(numbered);
+  };
+}
+
+FrameSolver::FrameSolver(const ShellSystem& system, IncrementalPotential& potential)
+    : system_(system),
+      potential_(potential),
+      dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()) {
+  const Scene& scene = system.scene();
+  if (contact_enabled(scene)) {
+    contact_ = std::make_unique<ContactTerm>(system_);
+    potential_.add_term(*contact_);
+    if (friction_enabled(scene))
+      friction_ = std::make_unique<FrictionTerm>(system_, scene.time.step);
+  }
+  if (strain_limit_enabled(scene)) {
+    strain_limit_ = std::make_unique<StrainLimitTerm>(system_);
+    strain_limit_->require_feasible(flat(system_.rest_mesh().vertices), "the rest state");
+    potential_.add_term(*strain_limit_);
+  }
+}
+
+void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
+                              const NewtonSettings& settings,
+                              const NewtonSolver::Progress& progress) {
+  if (!contact_) {
+    system_.apply_pins(x, record.time);
+    if (!std::isfinite(potential_.value(x)))
+      throw NumericalError(fmt::format(
+          "frame {}: moving the pinned vertices to their scripted positions inverts, degenerates "
+          "or stretches to the strain limit triangles next to them; use more frames (smaller "
+          "steps of the motion)",
+          record.frame));
+    return;
+  }
+  contact_->potential().reset_stats();
+  Eigen::VectorXd base_gradient;
+  potential_.base_gradient(x, base_gradient);
+  std::vector<bool> free(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) free[i] = dofs_.reduced(i) >= 0;
+  contact_->initialize_stiffness(x, base_gradient, free, potential_.inertia_weight());
+  if (move_scripted_vertices_if_safe(x, record.time)) return;
+
+  // Pull the vertices whose targets moved; the others stay fixed.
+  Eigen::VectorXd target = x;
+  system_.apply_pins(target, record.time);
+  std::vector<int> pulled, held;
+  std::vector<double> weights;
+  for (const PinnedVertex& p : system_.pinned()) {
+    if (target.segment<3>(3 * p.vertex) == x.segment<3>(3 * p.vertex)) {
+      held.push_back(p.vertex);
+      continue;
+    }
+    pulled.push_back(p.vertex);
+    const double mass = std::max(system_.dof_masses()[3 * p.vertex], contact_->average_mass());
+    weights.push_back(potential_.inertia_weight() * mass);
+  }
+  pull_.set(std::move(pulled), target, std::move(weights));
+  potential_.add_term(pull_);
+  const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
+  pull_.set_stiffness(kInitialPullStiffness);
+  for (int round = 0; round < kMaxPullRounds; ++round) {
+    append_solve(record.newton, solve_in_chunks(x, pulled_dofs, settings, progress));
+    ++record.kinematic_rounds;
+    if (move_scripted_vertices_if_safe(x, record.time)) break;
+    pull_.set_stiffness(kPullGrowth * pull_.stiffness());
+  }
+  potential_.remove_term(pull_);
+}
+
+bool FrameSolver::move_scripted_vertices_if_safe(Eigen::VectorXd& x, double time) {
+  Eigen::VectorXd target = x;
+  system_.apply_pins(target, time);
+  const Eigen::VectorXd move = target - x;
+  if (move.isZero(0.0)) return true;
+  if (potential_.max_feasible_step(x, move) < 1.0 || !std::isfinite(potential_.value(target)))
+    return false;
+  x = std::move(target);
+  return true;
+}
+
+NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs,
+                                          const NewtonSettings& settings,
+                                          const NewtonSolver::Progress& progress) {
+  const int interval = adaptive() ? kStiffnessUpdateInterval : settings.max_iterations;
+  NewtonResult total;
+  int done = 0;
+  // Numbered within the whole solve, across the chunks.
+  const NewtonSolver::Progress numbered = offset_progress(progress, done);
+  NewtonSettings chunk = settings;
+  while (true) {
+    chunk.max_iterations = std::min(interval, settings.max_iterations - done);
+    NewtonResult part = newton_.minimize(potential_, x, dofs, chunk, numbered);
+    done += part.iterations;
+    append_solve(total, std::move(part));
+    if (total.converged || total.stagnated || done >= settings.max_iterations) return total;
+    update_stiffnesses(x);
+  }
+}
+
+void FrameSolver::update_stiffnesses(const Eigen::VectorXd& x) {
+  if (contact_) contact_->update_stiffness(x);
+  if (strain_limit_) strain_limit_->update_stiffness(x);
+}
+
+void FrameSolver::solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous,
+                             const Eigen::VectorXd& frame_start, FrameRecord& record,
+                             const NewtonSettings& settings,
+                             const NewtonSolver::Progress& progress) {
+  if (!friction_) {
+    append_solve(record.newton, solve_in_chunks(x, dofs_, settings, progress));
+    return;
+  }
+  // IPC's outer loop: λ, T and w lagged at xᵗ, then at each solution, until the solution moves
+  // less than the Newton tolerance (the same velocity-like measure) between outer iterations.
+  // Without lagged contacts before and after a solve, re-solving would change nothing.
+  potential_.add_term(*friction_);
+  friction_->reset_seconds();
+  friction_->lag(contact_->potential(), previous, frame_start);
+  Eigen::VectorXd last_solution;
+  for (int iteration = 1;; ++iteration) {
+    const bool had_contacts = friction_->contact_count() > 0;
+    append_solve(record.newton, solve_in_chunks(x, dofs_, settings, progress));
+    ++record.friction_iterations;
+    const bool settled =
+        last_solution.size() == x.size() &&
+        (x - last_solution).lpNorm<Eigen::Infinity>() / settings.step_scale < settings.tolerance;
+    if (!record.newton.converged || settled || iteration == kMaxFrictionIterations) break;
+    friction_->lag(contact_->potential(), x, frame_start);
+    if (!had_contacts && friction_->contact_count() == 0) break;
+    last_solution = x;
+  }
+  potential_.remove_term(*friction_);
+  record.friction_seconds += friction_->seconds();
+}
+
+void FrameSolver::finish_frame(const Eigen::VectorXd& x, FrameRecord& record) {
+  if (!contact_) return;
+  Eigen::VectorXd target = x;
+  system_.apply_pins(target, record.time);
+  record.kinematic_offset = (target - x).lpNorm<Eigen::Infinity>();
+  record.barrier_stiffness = contact_->stiffness();
+  record.contact = contact_->potential().stats();
+}
+
+void FrameSolver::save_state(std::map<std::string, double>& state) const {
+  if (contact_) contact_->save_state(state);
+  if (strain_limit_) strain_limit_->save_state(state);
+}
+
+void FrameSolver::load_state(const std::map<std::string, double>& state) {
+  if (contact_) contact_->load_state(state);
+  if (strain_limit_) strain_limit_->load_state(state);
+}
+
+void FrameSolver::require_feasible(const Eigen::VectorXd& x, const std::string& what) const {
+  if (strain_limit_) strain_limit_->require_feasible(x, what);
+}
+
+}  // namespace psq
