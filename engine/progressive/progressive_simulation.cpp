@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -25,6 +27,15 @@ constexpr const char* kSettleGrowth = "progressive.settle_growth";
 constexpr const char* kSettled = "progressive.settled";
 constexpr const char* kLevelConverged = "progressive.level_converged";  // before settling_failed
 constexpr const char* kSettlingFailed = "progressive.settling_failed";
+constexpr const char* kBestChange = "progressive.best_change";
+constexpr const char* kStalledSteps = "progressive.stalled_steps";
+
+/// Settling steps at the largest time step in a row that do not bring the change 1 % below the
+/// best one so far before a settling is given up: a state cycling between two answers (friction
+/// lagged at each step's start, on the draped cloth: the same change to four digits, step after
+/// step) would otherwise take max_settle_steps steps.
+constexpr int kMaxStalledSettleSteps = 8;
+constexpr double kSettleProgress = 0.99;
 
 /// The shells and colliders of `system` as named parts, for intersection listings.
 std::vector<TrianglePart> triangle_parts(const ShellSystem& system) {
@@ -223,6 +234,8 @@ void ProgressiveSimulation::enter_level(int level) {
   settled_ = level == 0;
   settling_failed_ = false;
   settle_steps_ = 0;
+  best_change_ = std::numeric_limits<double>::infinity();
+  stalled_steps_ = 0;
   settle_growth_ = 0;
 }
 
@@ -271,8 +284,14 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   if (out.settling) {
     const bool done = settling_done(settle_growth_, out.change, tolerance());
     ++settle_steps_;
+    if (settle_growth_ >= kSettlingGrowthSteps) {
+      const bool progress_made = out.change < kSettleProgress * best_change_;
+      stalled_steps_ = progress_made ? 0 : stalled_steps_ + 1;
+      best_change_ = std::min(best_change_, out.change);
+    }
     settle_growth_ = next_settling_growth(settle_growth_, converged_at_start);
-    settled_ = done || settle_steps_ >= settings_.max_settle_steps;
+    settled_ = done || settle_steps_ >= settings_.max_settle_steps ||
+               stalled_steps_ >= kMaxStalledSettleSteps;
     if (settled_ && !done) settling_failed_ = true;
     out.equilibrium = done;
     if (done) out.frame.static_residual = out.frame.newton.step_norm;
@@ -280,6 +299,8 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     // The frame's step is the settling schedule's first, at Δt.
     settled_ = !frame_settles(frame);
     settle_steps_ = 0;
+    best_change_ = std::numeric_limits<double>::infinity();
+    stalled_steps_ = 0;
     settle_growth_ = next_settling_growth(0, converged_at_start);
   }
   return out;
@@ -299,8 +320,8 @@ void ProgressiveSimulation::refine() {
   level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
   if (contact) {
     RefinementStats stats;
-    next = safe_initialize(level_system(), expansion.parent, expansion.color, coarse, next,
-                           level_, stats);
+    next = safe_initialize(level_system(), expansion.parent, expansion.color, coarse,
+                           to_next_[level_ - 1].apply_linear(coarse), next, level_, stats);
     refinements_.push_back(stats);
   }
   x_ = std::move(next);
@@ -313,7 +334,10 @@ std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
                                       {kSettleSteps, settle_steps_},
                                       {kSettleGrowth, settle_growth_},
                                       {kSettled, settled_ ? 1.0 : 0.0},
-                                      {kSettlingFailed, settling_failed_ ? 1.0 : 0.0}};
+                                      {kSettlingFailed, settling_failed_ ? 1.0 : 0.0},
+                                      {kStalledSteps, stalled_steps_}};
+  // Stored values must be finite; none is stored before the first step at the largest Δt.
+  if (std::isfinite(best_change_)) state[kBestChange] = best_change_;
   stepper_->frame_solver().save_state(state);
   return state;
 }
@@ -355,6 +379,8 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
   if (frames_done && settle_steps && settled && (failed || converged)) {
     frame_ = static_cast<int>(*frames_done);
     settle_steps_ = static_cast<int>(*settle_steps);
+    best_change_ = stored(kBestChange).value_or(std::numeric_limits<double>::infinity());
+    stalled_steps_ = static_cast<int>(stored(kStalledSteps).value_or(0.0));
     // Stores written before the growth index existed grew Δt once per settling step.
     settle_growth_ = static_cast<int>(
         stored(kSettleGrowth).value_or(std::min(settle_steps_, kSettlingGrowthSteps)));

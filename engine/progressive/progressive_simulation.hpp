@@ -96,7 +96,7 @@ class ProgressiveSimulation {
   /// previews whose steps may stop at preview_iterations.
   [[nodiscard]] bool finest_level() const { return level_ + 1 == level_count_; }
   /// Whether the current level is done and every settling of its frames met its tolerance
-  /// (rather than stopping at max_settle_steps).
+  /// (rather than stopping at max_settle_steps or stalling).
   [[nodiscard]] bool level_converged() const { return level_done() && !settling_failed_; }
 
   /// Tolerance on ‖d‖∞/Δt (and on the settling change) at the current level.
@@ -170,9 +170,13 @@ class ProgressiveSimulation {
   int frame_ = 0;
   /// The frame reached (frame_) needs no more settling steps.
   bool settled_ = false;
-  /// A settling of this level stopped at max_settle_steps without passing its test.
+  /// A settling of this level stopped (at max_settle_steps, or stalled) without passing its test.
   bool settling_failed_ = false;
   int settle_steps_ = 0;
+  /// The smallest settling change at the largest time step so far, and the steps since it last
+  /// improved by 1 % (a stalled settling is given up).
+  double best_change_ = 0.0;
+  int stalled_steps_ = 0;
   /// Index of the settling time step (settling_time_step, next_settling_growth).
   int settle_growth_ = 0;
   /// Newton iterations already taken in the next step before a restore (0: start it afresh).

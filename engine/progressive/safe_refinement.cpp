@@ -26,8 +26,15 @@ namespace {
 /// The first perturbation moves a cluster's farthest child by g/kPerturbationDivisor: an order
 /// of magnitude below the gap (§4.4.2), so that only the patch itself can intersect.
 constexpr double kPerturbationDivisor = 10.0;
-/// Random rotations tried per cluster after the first perturbation intersects.
-constexpr int kMaxPerturbationTries = 64;
+/// The smallest perturbation, relative to the bounding-box diagonal: IPC leaves gaps far below
+/// d̂ in tight contact (1e-10 m seen), and a perturbation below about 1e-13 of the coordinates is
+/// lost to rounding.
+constexpr double kPerturbationFloor = 1e-7;
+/// Layouts tried per cluster (the target layout, the fitted rest layout, then random rotations
+/// of it) before the cluster is expanded one vertex at a time instead.
+constexpr int kClusterLayoutTries = 8;
+/// Random directions tried per vertex when a cluster is expanded one vertex at a time.
+constexpr int kVertexDirectionTries = 64;
 /// ACCD ratio bounds (§4.4.2): pairs closer than g keep 99.9 % of their gap, others 10 %.
 constexpr double kCloseRatioBound = 0.999;
 constexpr double kFarRatioBound = 0.1;
@@ -116,6 +123,45 @@ std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& y
   return vertices;
 }
 
+/// Whether the triangles of the mixed mesh at y around fine vertex `vertex` are clean: none
+/// degenerate, none intersecting a triangle (of a body that may touch) whose box overlaps theirs.
+bool vertex_patch_clean(const MixedMesh& mesh, const Positions& y, int vertex,
+                        const BodyPairRule& may_touch) {
+  const Positions p = mesh.positions(y);
+  const auto found = std::find(mesh.fine_vertex.begin(), mesh.fine_vertex.end(), vertex);
+  const int m = static_cast<int>(found - mesh.fine_vertex.begin());
+  const auto box_of = [&](Eigen::Index t) {
+    Eigen::AlignedBox3d box;
+    for (int k = 0; k < 3; ++k) box.extend(row(p, mesh.triangles(t, k)));
+    return box;
+  };
+  std::vector<int> incident, nearby;
+  Eigen::AlignedBox3d around;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+    if (mesh.triangles(t, 0) == m || mesh.triangles(t, 1) == m || mesh.triangles(t, 2) == m) {
+      incident.push_back(static_cast<int>(t));
+      around.extend(box_of(t));
+    }
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+    if (std::find(incident.begin(), incident.end(), t) == incident.end() &&
+        around.intersects(box_of(t)))
+      nearby.push_back(static_cast<int>(t));
+  std::vector<int> local = incident;
+  local.insert(local.end(), nearby.begin(), nearby.end());
+  Triangles triangles(static_cast<Eigen::Index>(local.size()), 3);
+  for (std::size_t i = 0; i < local.size(); ++i)
+    triangles.row(static_cast<Eigen::Index>(i)) = mesh.triangles.row(local[i]);
+  const IntersectionReport report = find_intersections(p, triangles);
+  const auto is_incident = [&](int i) { return i < static_cast<int>(incident.size()); };
+  for (int t : report.degenerate_triangles)
+    if (is_incident(t)) return false;
+  for (const auto& [a, b] : report.intersecting_pairs)
+    if ((is_incident(a) || is_incident(b)) &&
+        may_touch(mesh.triangle_body[local[a]], mesh.triangle_body[local[b]]))
+      return false;
+  return true;
+}
+
 /// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
 /// displacements `delta` (rows per fine vertex; zero rows stay): rounds of ACCD over the swept
 /// candidates, each moving all by the smallest safe fraction and then stopping the vertices of
@@ -187,11 +233,36 @@ double mixed_gap(const MixedMesh& mesh, const BodyPairRule& may_touch, const Pos
   return broad.clearance(mesh.positions(y), 0.0, cap);
 }
 
+/// The random numbers of a retry, seeded by the level, the vertex and the try, so that a
+/// resumed run repeats them.
+std::mt19937_64 seeded_random(int level, int vertex, int tries) {
+  return std::mt19937_64(static_cast<std::uint64_t>(level) * 1'000'003u +
+                         static_cast<std::uint64_t>(vertex) * 65'537u +
+                         static_cast<std::uint64_t>(static_cast<std::int64_t>(tries) + 1));
+}
+
+/// The children of coarse vertex k after the first, in breadth-first order over the fine
+/// mesh's edges within the cluster (a collapse cluster is connected), unreached ones last.
+std::vector<int> breadth_first(const std::vector<int>& cluster,
+                               const std::vector<std::vector<int>>& neighbours,
+                               const std::vector<int>& parent, int k) {
+  std::vector<int> order{cluster.front()};
+  std::set<int> seen{cluster.front()};
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (int w : neighbours[order[i]])
+      if (parent[w] == k && seen.insert(w).second) order.push_back(w);
+  for (int v : cluster)
+    if (seen.insert(v).second) order.push_back(v);
+  order.erase(order.begin());
+  return order;
+}
+
 }  // namespace
 
 Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
-                                const Eigen::VectorXd& target, int level,
+                                const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
+                                int level,
                                 RefinementStats& stats) {
   const Clock::time_point start = Clock::now();
   stats = RefinementStats{};
@@ -201,11 +272,19 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   AdditiveCcdSettings ccd = parameters.ccd;
   ccd.min_distance = parameters.band.thickness;
   const double cap = parameters.band.thickness + parameters.band.activation_distance;
+  const double perturbation_floor =
+      kPerturbationFloor * bounding_box_diagonal(fine.rest_mesh().vertices);
   const int n = static_cast<int>(parent.size());
   const int coarse_count = static_cast<int>(color.size());
   const Eigen::Map<const Positions> coarse = as_positions(coarse_x);
   const Eigen::Map<const Positions> goal = as_positions(target);
+  const Eigen::Map<const Positions> anchor = as_positions(anchors);
 
+  std::vector<std::vector<int>> neighbours(n);
+  for (const auto& e : surface.edges) {
+    neighbours[e[0]].push_back(e[1]);
+    neighbours[e[1]].push_back(e[0]);
+  }
   std::vector<std::vector<int>> children(coarse_count);
   for (int v = 0; v < n; ++v) children[parent[v]].push_back(v);
   Positions y(n, 3);
@@ -225,14 +304,49 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       expand(k);
   }
 
-  // The children of k at parent + s·R·(target − parent), the farthest at `radius`.
-  const auto perturb = [&](int k, const Eigen::Matrix3d& rotation, double radius) {
+  // The children of k at parent + s·R·(layout offset), the farthest at `radius`: the layout is
+  // the anchors or the targets about the parent, or the children's rest positions about their
+  // centroid.
+  enum class Layout { anchors, targets, rest };
+  const Positions& fine_rest = fine.rest_mesh().vertices;
+  const auto place = [&](int k, const Eigen::Matrix3d& rotation, double radius, Layout layout) {
     const Eigen::Vector3d centre = row(coarse, k);
+    Eigen::Vector3d origin = centre;
+    if (layout == Layout::rest) {
+      origin.setZero();
+      for (int v : children[k]) origin += row(fine_rest, v);
+      origin /= static_cast<double>(children[k].size());
+    }
+    const auto offset = [&](int v) -> Eigen::Vector3d {
+      switch (layout) {
+        case Layout::anchors: return row(anchor, v) - origin;
+        case Layout::targets: return row(goal, v) - origin;
+        case Layout::rest: break;
+      }
+      return row(fine_rest, v) - origin;
+    };
     double farthest = 0.0;
-    for (int v : children[k]) farthest = std::max(farthest, (row(goal, v) - centre).norm());
+    for (int v : children[k]) farthest = std::max(farthest, offset(v).norm());
     const double scale = farthest > 0.0 ? radius / farthest : 0.0;
+    for (int v : children[k]) y.row(v) = (centre + scale * (rotation * offset(v))).transpose();
+  };
+  // The rotation that best maps the children's rest layout onto their target layout (Kabsch).
+  const auto fitted_rotation = [&](int k) {
+    Eigen::Vector3d rest_mean = Eigen::Vector3d::Zero(), goal_mean = Eigen::Vector3d::Zero();
+    for (int v : children[k]) {
+      rest_mean += row(fine_rest, v);
+      goal_mean += row(goal, v);
+    }
+    rest_mean /= static_cast<double>(children[k].size());
+    goal_mean /= static_cast<double>(children[k].size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     for (int v : children[k])
-      y.row(v) = (centre + scale * (rotation * (row(goal, v) - centre))).transpose();
+      covariance += (row(goal, v) - goal_mean) * (row(fine_rest, v) - rest_mean).transpose();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
+                                                Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
+    flip(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    return Eigen::Matrix3d(svd.matrixU() * flip * svd.matrixV().transpose());
   };
 
   stats.smallest_gap = std::numeric_limits<double>::infinity();
@@ -250,35 +364,96 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     stats.expansions += static_cast<int>(clusters.size());
 
     phase = Clock::now();
-    const double radius = (gap - ccd.min_distance) / kPerturbationDivisor;
+    // Below a floor the perturbation would be lost to rounding; the exact checks, not the
+    // bound, then keep it intersection-free.
+    const double radius =
+        std::max((gap - ccd.min_distance) / kPerturbationDivisor, perturbation_floor);
     for (int k : clusters) {
       expand(k);
-      perturb(k, Eigen::Matrix3d::Identity(), radius);
+      place(k, Eigen::Matrix3d::Identity(), radius, Layout::anchors);
     }
-    MixedMesh mixed(surface, representative);
     std::set<int> failing;
     for (int tries = 0;; ++tries) {
       failing.clear();
-      for (int v : intersecting_vertices(mixed, y, surface.may_touch))
+      for (int v : intersecting_vertices(MixedMesh(surface, representative), y, surface.may_touch))
         if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
           failing.insert(parent[v]);
-      if (failing.empty()) break;
-      if (tries == kMaxPerturbationTries)
-        throw NumericalError(fmt::format(
-            "refinement to level {}: no intersection-free perturbation of the expansion of "
-            "level-{} vertex {} found in {} tries; use fewer levels or a smaller "
-            "[hierarchy] vertex_ratio step",
-            level, level - 1, *failing.begin(), kMaxPerturbationTries));
+      if (failing.empty() || tries == kClusterLayoutTries) break;
       for (int k : failing) {
-        // Seeded by the level, the cluster and the try, so that a resumed run repeats it.
-        std::mt19937_64 random(static_cast<std::uint64_t>(level) * 1'000'003u +
-                               static_cast<std::uint64_t>(k) * 65'537u +
-                               static_cast<std::uint64_t>(tries));
+        ++stats.perturbation_retries;
+        if (tries == 0) {
+          place(k, Eigen::Matrix3d::Identity(), radius, Layout::targets);
+          continue;
+        }
+        if (tries == 1) {
+          place(k, fitted_rotation(k), radius, Layout::rest);
+          continue;
+        }
+        std::mt19937_64 random = seeded_random(level, k, tries);
         std::normal_distribution<double> normal;
         const Eigen::Quaterniond q(normal(random), normal(random), normal(random), normal(random));
-        perturb(k, q.normalized().toRotationMatrix(), radius);
-        ++stats.perturbation_retries;
+        place(k, q.normalized().toRotationMatrix(), radius, Layout::rest);
       }
+    }
+    // Clusters no layout suits are expanded one vertex at a time, as single edge expansions
+    // (§4.4.1): back to the parent's position, then each child in breadth-first order from the
+    // first splits off in a direction toward its target or, if its triangles intersect, in
+    // random ones.
+    for (int k : failing) {
+      const Eigen::Vector3d centre = row(coarse, k);
+      for (int v : children[k]) {
+        y.row(v) = centre.transpose();
+        representative[v] = children[k].front();
+      }
+    }
+    for (int k : failing) {
+      const Eigen::Vector3d centre = row(coarse, k);
+      double farthest = 0.0;
+      for (int v : children[k]) farthest = std::max(farthest, (row(anchor, v) - centre).norm());
+      for (int v : breadth_first(children[k], neighbours, parent, k)) {
+        representative[v] = v;
+        const MixedMesh mixed(surface, representative);
+        std::mt19937_64 random = seeded_random(level, v, -1);
+        std::normal_distribution<double> normal;
+        std::uniform_real_distribution<double> length(0.5, 1.0);
+        // Toward the neighbours v already has apart from the cluster's merged rest: the sector
+        // of the merged vertex's fan that v's triangles will take.
+        Eigen::Vector3d sector = Eigen::Vector3d::Zero();
+        for (int w : neighbours[v])
+          if (representative[w] != representative[children[k].front()])
+            sector += (row(y, w) - centre).normalized();
+        for (int tries = 0;; ++tries) {
+          // The anchor layout's place, the sector's direction, then that direction turned
+          // further and further at random, with random lengths.
+          Eigen::Vector3d offset = radius / farthest * (row(anchor, v) - centre);
+          if (tries > 0 || !(offset.norm() > 0.0)) {
+            const Eigen::Vector3d noise(normal(random), normal(random), normal(random));
+            const double spread = tries <= 1 ? 0.0 : static_cast<double>(tries) / kVertexDirectionTries;
+            Eigen::Vector3d direction = sector.normalized() + 2.0 * spread * noise.normalized();
+            if (!(sector.norm() > 0.0) || !(direction.norm() > 0.0)) direction = noise;
+            offset = (tries <= 1 ? 1.0 : length(random)) * radius * direction.normalized();
+          }
+          y.row(v) = (centre + offset).transpose();
+          if (vertex_patch_clean(mixed, y, v, surface.may_touch)) break;
+          ++stats.perturbation_retries;
+          if (tries == kVertexDirectionTries)
+            throw NumericalError(fmt::format(
+                "refinement to level {}: no intersection-free perturbation of level-{} vertex "
+                "{} found in {} tries while expanding level-{} vertex {}; use fewer levels or "
+                "a larger [hierarchy] vertex_ratio",
+                level, level, v, kVertexDirectionTries, level - 1, k));
+        }
+      }
+    }
+    const MixedMesh mixed(surface, representative);
+    if (!failing.empty()) {
+      const std::vector<int> bad = intersecting_vertices(mixed, y, surface.may_touch);
+      if (!bad.empty())
+        throw NumericalError(fmt::format(
+            "refinement to level {}: the expansion of level-{} vertex {} intersects after its "
+            "vertex-by-vertex perturbation; use fewer levels or a larger [hierarchy] "
+            "vertex_ratio",
+            level, level - 1, parent[bad.front()]));
     }
     stats.perturb_seconds += since(phase);
 

@@ -9,10 +9,16 @@
 // level-l triangles). Per colour:
 //   1. g, the smallest distance between primitives of the current mixed mesh that may touch;
 //   2. every cluster of the colour is perturbed: its children move from the parent's position
-//      toward their prolonged targets by a common factor, the farthest by g/10. Every point of
+//      toward their anchors (their intrinsic places on the deformed level-l surface, which
+//      lie in the sectors of the parent's one-ring their triangles take) by a common factor,
+//      the farthest by g/10. Every point of
 //      the new triangles is then within g/10 of the old surface, so only the expansion patch
-//      itself can intersect; the exact check decides, and a cluster whose patch intersects is
-//      tried again with its target layout turned by a random rotation (bounded tries);
+//      itself can intersect; the exact check decides. A cluster whose patch intersects is tried
+//      again toward its prolonged targets, then with the children's rest layout turned by the
+//      rotation that best fits it to the targets, then by random rotations; a cluster no layout
+//      suits is expanded one vertex at a time (single edge expansions, §4.4.1), each vertex
+//      toward its anchor, then into the sector of its neighbours, then in random directions,
+//      its triangles checked exactly (bounded tries, seeded so that a resumed run repeats them);
 //   3. the colour's vertices advance toward their targets by additive CCD (ACCD with the
 //      per-pair ratio bound: 0.999 for a pair already closer than g, 0.1 otherwise). The
 //      advance is repeated: each round moves every vertex by the smallest safe fraction, then
@@ -52,13 +58,15 @@ struct RefinementStats {
 /// The level-(l+1) initializer of `fine` (the level-(l+1) system, colliders included) from
 /// `coarse_x` (level l, intersection-free): `parent[v]` is the level-l vertex each level-(l+1)
 /// vertex collapsed into (a collider vertex: its own copy), `color[k]` the expansion colour of
-/// level-l vertex k, `target` the prolonged state P^l_{l+1}(x_l) with the pinned vertices at
+/// level-l vertex k, `anchors` the linear part U^l_{l+1} x_l of the prolongation (each vertex
+/// at its intrinsic place on the deformed level-l surface), `target` the prolonged state P^l_{l+1}(x_l) with the pinned vertices at
 /// their scripted positions. `level` (l+1) names the level in messages and stats.
 /// @throws NumericalError naming the level and vertex when no intersection-free perturbation
 /// of a cluster is found, or when the final state fails the exact check.
 Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
-                                const Eigen::VectorXd& target, int level,
+                                const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
+                                int level,
                                 RefinementStats& stats);
 
 }  // namespace psq

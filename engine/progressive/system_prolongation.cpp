@@ -63,6 +63,18 @@ Eigen::VectorXd SystemProlongation::apply(const Eigen::VectorXd& coarse) const {
   return out;
 }
 
+Eigen::VectorXd SystemProlongation::apply_linear(const Eigen::VectorXd& coarse) const {
+  Eigen::VectorXd out(target_size());
+  for (const Block& b : blocks_) {
+    const Eigen::Index rows = 3 * Eigen::Index(b.map.target_count());
+    const Eigen::Index cols = 3 * Eigen::Index(b.map.coarse_vertex_count());
+    out.segment(3 * Eigen::Index(b.first_target), rows) =
+        b.map.linear_part() * coarse.segment(3 * Eigen::Index(b.first_coarse), cols);
+  }
+  copy_colliders(coarse, shell_coarse_vertices_, out, shell_target_vertices_);
+  return out;
+}
+
 Eigen::VectorXd SystemProlongation::apply_linear_transpose(const Eigen::VectorXd& g) const {
   Eigen::VectorXd out(coarse_size());
   for (const Block& b : blocks_) {

@@ -26,6 +26,8 @@ class SystemProlongation {
 
   /// P(x) for flat coarse positions x (3n): flat target positions (3m).
   [[nodiscard]] Eigen::VectorXd apply(const Eigen::VectorXd& coarse) const;
+  /// Ux: the linear (intrinsic) part alone, each target at its anchor on the coarse surface.
+  [[nodiscard]] Eigen::VectorXd apply_linear(const Eigen::VectorXd& coarse) const;
   /// Uᵀg: the transpose of the linear (intrinsic) part, offsets held (paper eq. 10).
   [[nodiscard]] Eigen::VectorXd apply_linear_transpose(const Eigen::VectorXd& g) const;
   /// (∂P/∂x)ᵀg: the exact chain rule through the offsets.
