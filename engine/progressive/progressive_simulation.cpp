@@ -282,7 +282,10 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   frame_ = frame;
   const bool converged_at_start = out.frame.newton.converged && out.frame.newton.iterations == 0;
   if (out.settling) {
-    const bool done = settling_done(settle_growth_, out.change, tolerance());
+    // At the finest level the step that ends a settling must itself be solved to the tolerance;
+    // steps before it may stop at their budget on the way.
+    const bool done = settling_done(settle_growth_, out.change, tolerance()) &&
+                      (!finest_level() || out.frame.newton.converged);
     ++settle_steps_;
     if (settle_growth_ >= kSettlingGrowthSteps) {
       const bool progress_made = out.change < kSettleProgress * best_change_;
