@@ -36,8 +36,14 @@ FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd&
   int taken = iterations_done;
   const NewtonSolver::Progress numbered = numbered_through_frame(progress, taken);
   // A settling step's targets are where the pins already are: begin_frame then only raises κ to
-  // the balance at x, if that is higher.
-  frame_solver_.begin_frame(x, record, settings, numbered);
+  // the balance at x, if that is higher. The scripted vertices' way is solved with the scene's
+  // budget and judged even in a preview: a pull stopped after a preview's few iterations would
+  // be followed by stiffer pulls that crush the gaps, or leave the preview behind its script.
+  NewtonSettings scripted = settings;
+  scripted.max_iterations =
+      std::max(settings.max_iterations, system_.scene().solver.max_iterations - iterations_done);
+  scripted.judge_final_iterate = true;
+  frame_solver_.begin_frame(x, record, scripted, numbered);
   settings.max_iterations = std::max(0, settings.max_iterations - record.newton.iterations);
   frame_solver_.solve_held(x, previous, frame_start.size() > 0 ? frame_start : previous, record,
                            settings, numbered);
