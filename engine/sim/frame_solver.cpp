@@ -108,10 +108,6 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
     append_solve(record.newton, solve_in_chunks(x, pulled_dofs, settings, progress));
     ++record.kinematic_rounds;
     if (move_scripted_vertices_if_safe(x, record.time)) break;
-    // A preview step's round (its solve is not judged: a few iterations, then the next step)
-    // stopped short has not balanced its pull yet; a stiffer pull would only crush the gaps,
-    // and the next step pulls again.
-    if (!record.newton.converged && !settings.judge_final_iterate) break;
     pull_.set_stiffness(kPullGrowth * pull_.stiffness());
   }
   potential_.remove_term(pull_);
