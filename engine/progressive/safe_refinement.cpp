@@ -47,7 +47,12 @@ double since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-Eigen::Vector3d row(const Positions& p, int v) { return p.row(v).transpose(); }
+/// Row v of a position matrix or of a map of one (a template: a map bound to const Positions&
+/// would be copied whole on every call).
+template <class PositionMatrix>
+Eigen::Vector3d row(const PositionMatrix& p, int v) {
+  return p.row(v).transpose();
+}
 
 /// The level-(l+1) surface with some clusters not yet expanded: each fine vertex is represented
 /// by itself once expanded, else by its cluster's first child; triangles and edges whose
