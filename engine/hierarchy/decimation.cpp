@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -119,6 +120,8 @@ class Decimator {
   std::vector<TrackedPoint> points_;  ///< finest vertices first, then the last snapshot's
   std::vector<std::vector<int>> face_points_;
   std::vector<Vertex> snapshot_vertices_;  ///< vertices of the last snapshot, in its order
+  /// The collapses since the last snapshot, in order: (removed, survivor).
+  std::vector<std::array<Vertex, 2>> stage_collapses_;
   /// False while the last snapshot is the finest mesh, whose vertices are the finest points.
   bool snapshot_tracked_separately_ = false;
   std::optional<CollapseTrial> trial_;
@@ -366,6 +369,7 @@ void Decimator::commit(Vertex v0, Vertex v1, Vertex survivor) {
   CollapseTrial& trial = *trial_;
   const Vertex removed = survivor == v0 ? v1 : v0;
   merged_into_[removed] = survivor;
+  stage_collapses_.push_back({removed, survivor});
   if (trial.keep != Keep::kFree) {
     const Vertex kept = trial.keep == Keep::kV0 ? v0 : v1;
     pin_[survivor] = pin_[kept];
@@ -507,6 +511,12 @@ HierarchyLevel Decimator::snapshot() {
     while (merged_into_[v] != Mesh::null_vertex()) v = merged_into_[v];
     level.parent.push_back(index.at(v));
   }
+  std::map<Vertex, int> finer_index;
+  for (std::size_t i = 0; i < snapshot_vertices_.size(); ++i)
+    finer_index[snapshot_vertices_[i]] = static_cast<int>(i);
+  for (const auto& [removed, survivor] : stage_collapses_)
+    level.collapses.push_back({finer_index.at(removed), finer_index.at(survivor)});
+  stage_collapses_.clear();
 
   // Track this level's vertices for the next coarser level; the older snapshot is done.
   points_.resize(finest_count_);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -134,6 +136,9 @@ void write_level(Writer& w, const HierarchyLevel& level) {
   w.locations(level.next_finer);
   w.array(level.parent.data(), level.parent.size());
   w.array(level.expansion_color.data(), level.expansion_color.size());
+  std::vector<int> collapses;
+  for (const auto& [removed, survivor] : level.collapses) collapses.insert(collapses.end(), {removed, survivor});
+  w.array(collapses.data(), collapses.size());
 }
 
 HierarchyLevel read_level(Reader& r) {
@@ -145,6 +150,10 @@ HierarchyLevel read_level(Reader& r) {
   level.next_finer = r.locations();
   level.parent = r.array<int>();
   level.expansion_color = r.array<int>();
+  const std::vector<int> collapses = r.array<int>();
+  if (collapses.size() % 2 != 0) return {};  // rejected by valid_hierarchy (no rest mesh)
+  for (std::size_t i = 0; i < collapses.size(); i += 2)
+    level.collapses.push_back({collapses[i], collapses[i + 1]});
   return level;
 }
 
@@ -187,7 +196,12 @@ bool valid_hierarchy(const MeshHierarchy& h, const TriMesh& finest) {
         !valid_locations(level.next_finer, finer, level.rest.triangle_count()) ||
         level.parent.size() != finer || !all_in_range(level.parent, n) ||
         level.expansion_color.size() != (is_finest ? 0u : static_cast<std::size_t>(n)) ||
-        !all_in_range(level.expansion_color, std::max(n, 1))) {
+        !all_in_range(level.expansion_color, std::max(n, 1)) ||
+        level.collapses.size() != (is_finest ? 0u : finer - static_cast<std::size_t>(n)) ||
+        !std::all_of(level.collapses.begin(), level.collapses.end(), [&](const auto& c) {
+          return c[0] >= 0 && c[1] >= 0 && static_cast<std::size_t>(c[0]) < finer &&
+                 static_cast<std::size_t>(c[1]) < finer;
+        })) {
       return false;
     }
   }

@@ -15,7 +15,7 @@
 namespace psq {
 
 /// Raised whenever the file layout or the decimation rules change, so old files rebuild.
-inline constexpr std::uint32_t kHierarchyCacheVersion = 1;
+inline constexpr std::uint32_t kHierarchyCacheVersion = 2;  // 2: with the collapse order
 
 /// What load_or_build_hierarchy did.
 enum class HierarchyCacheOutcome {

@@ -6,6 +6,7 @@
 // (the input mesh itself).
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "engine/mesh/tri_mesh.hpp"
@@ -47,6 +48,11 @@ struct HierarchyLevel {
   /// parent it is). Two expansions of one colour never touch the same triangle of level l+1,
   /// so they can be carried out in parallel. Empty at the finest level.
   std::vector<int> expansion_color;
+  /// The collapses that took level l+1 to this level, in the order they were made: (removed,
+  /// survivor) as level-(l+1) vertex indices. Undone in reverse order they are single edge
+  /// expansions (paper §4.4.1), each splitting one vertex of normal valence. Empty at the
+  /// finest level.
+  std::vector<std::array<int, 2>> collapses;
 };
 
 /// The levels of one shell, coarsest first; levels.back().rest is the input mesh.

@@ -168,19 +168,26 @@ void ProgressiveSimulation::build_prolongations() {
 ProgressiveSimulation::Expansion ProgressiveSimulation::system_expansion(int level) const {
   Expansion expansion;
   int coarse_first = 0;
+  int fine_first = 0;
   for (const MeshHierarchy& h : hierarchies_) {
     const int here = shell_level(h, level, level_count_);
     const int next = shell_level(h, level + 1, level_count_);
     const int coarse_count = h.levels[here].rest.vertex_count();
     const int fine_count = h.levels[next].rest.vertex_count();
-    if (next != here && (static_cast<int>(h.levels[here].parent.size()) != fine_count ||
-                         static_cast<int>(h.levels[here].expansion_color.size()) != coarse_count))
+    if (next != here &&
+        (static_cast<int>(h.levels[here].parent.size()) != fine_count ||
+         static_cast<int>(h.levels[here].expansion_color.size()) != coarse_count ||
+         static_cast<int>(h.levels[here].collapses.size()) != fine_count - coarse_count))
       throw std::invalid_argument(fmt::format(
-          "ProgressiveSimulation: level {} of shell '{}' has no parents or expansion colours for "
-          "the safe refinement",
+          "ProgressiveSimulation: level {} of shell '{}' has no parents, expansion colours or "
+          "collapses for the safe refinement",
           here, finest_.shells()[&h - hierarchies_.data()].name));
     for (int v = 0; v < fine_count; ++v)
       expansion.parent.push_back(coarse_first + (next == here ? v : h.levels[here].parent[v]));
+    if (next != here)
+      for (const auto& [removed, survivor] : h.levels[here].collapses)
+        expansion.collapses.push_back({fine_first + removed, fine_first + survivor});
+    fine_first += fine_count;
     for (int k = 0; k < coarse_count; ++k)
       expansion.color.push_back(next == here ? 0 : h.levels[here].expansion_color[k]);
     coarse_first += coarse_count;
@@ -324,7 +331,8 @@ void ProgressiveSimulation::refine() {
   if (contact) {
     RefinementStats stats;
     next = safe_initialize(level_system(), expansion.parent, expansion.color, coarse,
-                           to_next_[level_ - 1].apply_linear(coarse), next, level_, stats);
+                           expansion.collapses, to_next_[level_ - 1].apply_linear(coarse), next,
+                           level_, stats);
     refinements_.push_back(stats);
   }
   x_ = std::move(next);

@@ -142,11 +142,13 @@ class ProgressiveSimulation {
   /// Validates the hierarchies, resolves the tolerances, enters level 0 at its rest state.
   void initialize();
   void build_prolongations();
-  /// Per level-(l+1) vertex of the system (shells, then colliders) its level-l parent, and per
-  /// level-l vertex its expansion colour: the shells' hierarchies renumbered into the systems.
+  /// Per level-(l+1) vertex of the system (shells, then colliders) its level-l parent, per
+  /// level-l vertex its expansion colour, and the collapses in order: the shells' hierarchies
+  /// renumbered into the systems.
   struct Expansion {
     std::vector<int> parent;
     std::vector<int> color;
+    std::vector<std::array<int, 2>> collapses;  ///< (removed, survivor), level-(l+1) indices
   };
   [[nodiscard]] Expansion system_expansion(int level) const;
   /// Makes `level` the current level (its system, objective and stepper).

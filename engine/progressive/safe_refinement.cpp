@@ -246,29 +246,13 @@ std::mt19937_64 seeded_random(int level, int vertex, int tries) {
                          static_cast<std::uint64_t>(static_cast<std::int64_t>(tries) + 1));
 }
 
-/// The children of coarse vertex k after the first, in breadth-first order over the fine
-/// mesh's edges within the cluster (a collapse cluster is connected), unreached ones last.
-std::vector<int> breadth_first(const std::vector<int>& cluster,
-                               const std::vector<std::vector<int>>& neighbours,
-                               const std::vector<int>& parent, int k) {
-  std::vector<int> order{cluster.front()};
-  std::set<int> seen{cluster.front()};
-  for (std::size_t i = 0; i < order.size(); ++i)
-    for (int w : neighbours[order[i]])
-      if (parent[w] == k && seen.insert(w).second) order.push_back(w);
-  for (int v : cluster)
-    if (seen.insert(v).second) order.push_back(v);
-  order.erase(order.begin());
-  return order;
-}
-
 }  // namespace
 
 Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
+                                const std::vector<std::array<int, 2>>& collapses,
                                 const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
-                                int level,
-                                RefinementStats& stats) {
+                                int level, RefinementStats& stats) {
   const Clock::time_point start = Clock::now();
   stats = RefinementStats{};
   stats.level = level;
@@ -292,6 +276,16 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   }
   std::vector<std::vector<int>> children(coarse_count);
   for (int v = 0; v < n; ++v) children[parent[v]].push_back(v);
+  // Per coarse vertex, its cluster's collapses (indices into `collapses`, in order), and the
+  // survivor each removed vertex is merged into while its collapse is not undone (−1: split).
+  std::vector<std::vector<int>> cluster_collapses(coarse_count);
+  for (std::size_t c = 0; c < collapses.size(); ++c)
+    cluster_collapses[parent[collapses[c][0]]].push_back(static_cast<int>(c));
+  std::vector<int> merged_into(n, -1);
+  const auto root = [&](int v) {
+    while (merged_into[v] >= 0) v = merged_into[v];
+    return v;
+  };
   Positions y(n, 3);
   std::vector<int> representative(n);
   for (int v = 0; v < n; ++v) {
@@ -400,53 +394,55 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
         place(k, q.normalized().toRotationMatrix(), radius, Layout::rest);
       }
     }
-    // Clusters no layout suits are expanded one vertex at a time, as single edge expansions
-    // (§4.4.1): back to the parent's position, then each child in breadth-first order from the
-    // first splits off in a direction toward its target or, if its triangles intersect, in
-    // random ones.
+    // Clusters no layout suits are expanded by undoing their collapses one at a time, latest
+    // first (single edge expansions, §4.4.1): back to the parent's position, then each removed
+    // vertex splits off its survivor (taking along the vertices merged into it) toward its
+    // anchor's offset from the survivor's, then into the sector of its neighbours outside the
+    // survivor's group, then in directions turned further and further at random, its triangles
+    // checked exactly after each try.
     for (int k : failing) {
       const Eigen::Vector3d centre = row(coarse, k);
-      for (int v : children[k]) {
-        y.row(v) = centre.transpose();
-        representative[v] = children[k].front();
-      }
+      for (int v : children[k]) y.row(v) = centre.transpose();
+      for (int c : cluster_collapses[k]) merged_into[collapses[c][0]] = collapses[c][1];
+      for (int v : children[k]) representative[v] = root(v);
     }
     for (int k : failing) {
-      const Eigen::Vector3d centre = row(coarse, k);
-      double farthest = 0.0;
-      for (int v : children[k]) farthest = std::max(farthest, (row(anchor, v) - centre).norm());
-      for (int v : breadth_first(children[k], neighbours, parent, k)) {
-        representative[v] = v;
+      for (auto c = cluster_collapses[k].rbegin(); c != cluster_collapses[k].rend(); ++c) {
+        const auto [removed, survivor] = collapses[*c];
+        merged_into[removed] = -1;
+        std::vector<int> group;  // removed and the vertices still merged into it
+        for (int v : children[k]) {
+          representative[v] = root(v);
+          if (representative[v] == removed) group.push_back(v);
+        }
         const MixedMesh mixed(surface, representative);
-        std::mt19937_64 random = seeded_random(level, v, -1);
+        const Eigen::Vector3d from = row(y, survivor);
+        std::mt19937_64 random = seeded_random(level, removed, -1);
         std::normal_distribution<double> normal;
         std::uniform_real_distribution<double> length(0.5, 1.0);
-        // Toward the neighbours v already has apart from the cluster's merged rest: the sector
-        // of the merged vertex's fan that v's triangles will take.
         Eigen::Vector3d sector = Eigen::Vector3d::Zero();
-        for (int w : neighbours[v])
-          if (representative[w] != representative[children[k].front()])
-            sector += (row(y, w) - centre).normalized();
+        for (int w : neighbours[removed])
+          if (representative[w] != representative[survivor] && representative[w] != removed)
+            sector += (row(y, representative[w]) - from).normalized();
+        const Eigen::Vector3d toward_anchor = row(anchor, removed) - row(anchor, survivor);
         for (int tries = 0;; ++tries) {
-          // The anchor layout's place, the sector's direction, then that direction turned
-          // further and further at random, with random lengths.
-          Eigen::Vector3d offset = radius / farthest * (row(anchor, v) - centre);
-          if (tries > 0 || !(offset.norm() > 0.0)) {
+          Eigen::Vector3d direction = toward_anchor;
+          if (tries > 0 || !(direction.norm() > 0.0)) {
             const Eigen::Vector3d noise(normal(random), normal(random), normal(random));
             const double spread = tries <= 1 ? 0.0 : static_cast<double>(tries) / kVertexDirectionTries;
-            Eigen::Vector3d direction = sector.normalized() + 2.0 * spread * noise.normalized();
+            direction = sector.normalized() + 2.0 * spread * noise.normalized();
             if (!(sector.norm() > 0.0) || !(direction.norm() > 0.0)) direction = noise;
-            offset = (tries <= 1 ? 1.0 : length(random)) * radius * direction.normalized();
           }
-          y.row(v) = (centre + offset).transpose();
-          if (vertex_patch_clean(mixed, y, v, surface.may_touch)) break;
+          const double reach = (tries <= 1 ? 1.0 : length(random)) * radius;
+          for (int v : group) y.row(v) = (from + reach * direction.normalized()).transpose();
+          if (vertex_patch_clean(mixed, y, removed, surface.may_touch)) break;
           ++stats.perturbation_retries;
           if (tries == kVertexDirectionTries)
             throw NumericalError(fmt::format(
                 "refinement to level {}: no intersection-free perturbation of level-{} vertex "
                 "{} found in {} tries while expanding level-{} vertex {}; use fewer levels or "
                 "a larger [hierarchy] vertex_ratio",
-                level, level, v, kVertexDirectionTries, level - 1, k));
+                level, level, removed, kVertexDirectionTries, level - 1, k));
         }
       }
     }

@@ -16,9 +16,10 @@
 //      itself can intersect; the exact check decides. A cluster whose patch intersects is tried
 //      again toward its prolonged targets, then with the children's rest layout turned by the
 //      rotation that best fits it to the targets, then by random rotations; a cluster no layout
-//      suits is expanded one vertex at a time (single edge expansions, §4.4.1), each vertex
-//      toward its anchor, then into the sector of its neighbours, then in random directions,
-//      its triangles checked exactly (bounded tries, seeded so that a resumed run repeats them);
+//      suits is expanded by undoing its collapses latest first (single edge expansions,
+//      §4.4.1): each removed vertex splits off its survivor toward its anchor's offset, then
+//      into the sector of its neighbours, then in random directions, its triangles checked
+//      exactly (bounded tries, seeded so that a resumed run repeats them);
 //   3. the colour's vertices advance toward their targets by additive CCD (ACCD with the
 //      per-pair ratio bound: 0.999 for a pair already closer than g, 0.1 otherwise). The
 //      advance is repeated: each round moves every vertex by the smallest safe fraction, then
@@ -31,6 +32,7 @@
 // triangle); the broad phase is built once per batch over the batch's whole motion.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "engine/sim/shell_system.hpp"
@@ -58,13 +60,15 @@ struct RefinementStats {
 /// The level-(l+1) initializer of `fine` (the level-(l+1) system, colliders included) from
 /// `coarse_x` (level l, intersection-free): `parent[v]` is the level-l vertex each level-(l+1)
 /// vertex collapsed into (a collider vertex: its own copy), `color[k]` the expansion colour of
-/// level-l vertex k, `anchors` the linear part U^l_{l+1} x_l of the prolongation (each vertex
+/// level-l vertex k, `collapses` the collapses that made level l from level l+1 in order
+/// ((removed, survivor), level-(l+1) indices; HierarchyLevel::collapses), `anchors` the linear part U^l_{l+1} x_l of the prolongation (each vertex
 /// at its intrinsic place on the deformed level-l surface), `target` the prolonged state P^l_{l+1}(x_l) with the pinned vertices at
 /// their scripted positions. `level` (l+1) names the level in messages and stats.
 /// @throws NumericalError naming the level and vertex when no intersection-free perturbation
 /// of a cluster is found, or when the final state fails the exact check.
 Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
+                                const std::vector<std::array<int, 2>>& collapses,
                                 const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
                                 int level,
                                 RefinementStats& stats);

@@ -158,6 +158,33 @@ TEST(BuildHierarchy, ParentsMapEveryFinerVertexOntoTheCoarserLevel) {
   }
 }
 
+TEST(BuildHierarchy, RecordedCollapsesReplayedGiveTheParents) {
+  // Each collapse removes one finer vertex into a survivor; following the survivors to the end
+  // must land on each vertex's parent, and the coarse vertices are the finer ones never removed.
+  for (const auto& [named, h] : test_hierarchies()) {
+    for (int l = 0; l + 1 < h.level_count(); ++l) {
+      const HierarchyLevel& coarse = h.levels[l];
+      const int finer = h.levels[l + 1].rest.vertex_count();
+      ASSERT_EQ(static_cast<int>(coarse.collapses.size()), finer - coarse.rest.vertex_count());
+      std::vector<int> merged_into(finer, -1);
+      for (const auto& [removed, survivor] : coarse.collapses) {
+        ASSERT_EQ(merged_into[removed], -1) << named.name << ": vertex removed twice";
+        ASSERT_EQ(merged_into[survivor], -1) << named.name << ": survivor already removed";
+        merged_into[removed] = survivor;
+      }
+      std::vector<int> root_of_parent(coarse.rest.vertex_count(), -1);
+      for (int v = 0; v < finer; ++v) {
+        int root = v;
+        while (merged_into[root] >= 0) root = merged_into[root];
+        // One root per coarse vertex: the finer vertex that survived into it.
+        int& recorded = root_of_parent[coarse.parent[v]];
+        if (recorded < 0) recorded = root;
+        EXPECT_EQ(recorded, root) << named.name << " level " << l << " vertex " << v;
+      }
+    }
+  }
+}
+
 TEST(BuildHierarchy, ExpansionsOfOneColourTouchNoCommonFinerTriangle) {
   for (const auto& [named, h] : test_hierarchies()) {
     for (int l = 0; l + 1 < h.level_count(); ++l) {

@@ -28,6 +28,7 @@ void expect_identical(const MeshHierarchy& a, const MeshHierarchy& b) {
     EXPECT_EQ(x.pin_group, y.pin_group);
     EXPECT_EQ(x.parent, y.parent);
     EXPECT_EQ(x.expansion_color, y.expansion_color);
+    EXPECT_EQ(x.collapses, y.collapses);
     ASSERT_EQ(x.finest.size(), y.finest.size());
     for (std::size_t i = 0; i < x.finest.size(); ++i) {
       EXPECT_EQ(x.finest[i].triangle, y.finest[i].triangle);
