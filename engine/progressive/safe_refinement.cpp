@@ -41,6 +41,9 @@ constexpr double kFarRatioBound = 0.1;
 /// Additive CCD rounds per advance; each round stops at least one pair's vertices, so the cap
 /// only ends advances whose limiting pairs keep changing.
 constexpr int kMaxAdvanceRounds = 200;
+/// Halvings of an advance that folds neighbouring triangles through each other before the
+/// folding vertices are stopped instead.
+constexpr int kMaxFoldHalvings = 20;
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point start) {
@@ -109,15 +112,18 @@ struct MixedMesh {
   }
 };
 
-/// The fine vertices of the triangles that intersect (pairs of bodies that may touch) or are
-/// degenerate in the mixed mesh at y; empty when it is clean.
-std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& y,
-                                       const BodyPairRule& may_touch) {
-  const Positions p = mesh.positions(y);
+/// The vertices (fine numbering when `fine`, else the mixed mesh's) of the triangles that
+/// intersect (pairs of bodies that may touch) or are degenerate in the mixed mesh at mixed
+/// positions p; empty when it is clean.
+std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& p,
+                                       const BodyPairRule& may_touch, bool fine) {
   const IntersectionReport report = find_intersections(p, mesh.triangles);
   std::vector<int> vertices;
   const auto add_triangle = [&](int t) {
-    for (int k = 0; k < 3; ++k) vertices.push_back(mesh.fine_vertex[mesh.triangles(t, k)]);
+    for (int k = 0; k < 3; ++k) {
+      const int m = mesh.triangles(t, k);
+      vertices.push_back(fine ? mesh.fine_vertex[m] : m);
+    }
   };
   for (const auto& [a, b] : report.intersecting_pairs) {
     if (!may_touch(mesh.triangle_body[a], mesh.triangle_body[b])) continue;
@@ -126,6 +132,12 @@ std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& y
   }
   for (int t : report.degenerate_triangles) add_triangle(t);
   return vertices;
+}
+
+/// The same at fine positions y, in fine numbering.
+std::vector<int> intersecting_vertices(const MixedMesh& mesh, const Positions& y,
+                                       const BodyPairRule& may_touch) {
+  return intersecting_vertices(mesh, mesh.positions(y), may_touch, true);
 }
 
 /// Whether the triangles of the mixed mesh at y around fine vertex `vertex` are clean: none
@@ -216,9 +228,23 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
                                               : edge_edge_ccd(start, stop, settings);
       if (result.collision) toi[i] = result.toi;
     });
-    const double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
+    double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
+    // The CCD sees no pair of neighbouring triangles: the motion, blind to physics, may fold two
+    // of them through each other across their shared edge. The exact check catches that; the
+    // step is halved, and the vertices of a fold that remains are stopped.
+    std::vector<int> folded;
+    for (int halvings = 0; alpha > 0.0; ++halvings) {
+      folded = intersecting_vertices(mesh, p + alpha * d, may_touch, false);
+      if (folded.empty()) break;
+      if (halvings == kMaxFoldHalvings) {
+        alpha = 0.0;
+        break;
+      }
+      alpha *= 0.5;
+    }
     p += alpha * d;
     if (alpha >= 1.0) break;
+    for (int m : folded) d.row(m).setZero();
     d *= 1.0 - alpha;
     for (std::size_t i = 0; i < toi.size(); ++i) {
       if (toi[i] > alpha) continue;
@@ -400,11 +426,27 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     // anchor's offset from the survivor's, then into the sector of its neighbours outside the
     // survivor's group, then in directions turned further and further at random, its triangles
     // checked exactly after each try.
-    for (int k : failing) {
+    // Merging a cluster back can bring its fan against a neighbouring cluster's perturbation
+    // that was checked against the cluster's failed layout only: such clusters are merged back
+    // and replayed too.
+    const auto merge_back = [&](int k) {
       const Eigen::Vector3d centre = row(coarse, k);
       for (int v : children[k]) y.row(v) = centre.transpose();
       for (int c : cluster_collapses[k]) merged_into[collapses[c][0]] = collapses[c][1];
       for (int v : children[k]) representative[v] = root(v);
+    };
+    for (int k : failing) merge_back(k);
+    while (!failing.empty()) {
+      std::set<int> more;
+      for (int v : intersecting_vertices(MixedMesh(surface, representative), y, surface.may_touch))
+        if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color &&
+            !failing.contains(parent[v]))
+          more.insert(parent[v]);
+      if (more.empty()) break;
+      for (int k : more) {
+        merge_back(k);
+        failing.insert(k);
+      }
     }
     for (int k : failing) {
       for (auto c = cluster_collapses[k].rbegin(); c != cluster_collapses[k].rend(); ++c) {
