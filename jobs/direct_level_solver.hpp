@@ -78,18 +78,14 @@ class ProgressiveLevelSolver final : public LevelSolver {
   bool level_done() const override { return simulation_.level_done(); }
   bool finished() const override { return simulation_.finished(); }
   LevelFrame step(const Progress& progress) override {
-    const bool finest = simulation_.finest_level();
     const ProgressiveStep step = simulation_.step(
         [&](int, int frame, const NewtonIteration& iteration) { progress(frame, iteration); });
     const NewtonResult& newton = step.frame.newton;
-    // A finest-level settling step may stop at its budget on the way; the one that ends the
-    // settling must have reached the equilibrium.
-    const bool must_converge = finest && (!step.settling || simulation_.frame_settled());
     return {.level = step.level,
             .frame = step.frame.frame,
-            .converged = newton.converged && (!step.settling || step.equilibrium),
+            .converged = step.converged,
             .stagnated = newton.stagnated,
-            .must_converge = must_converge,
+            .must_converge = step.judged,
             .iterations = newton.iterations,
             .step_norm = newton.step_norm,
             .gradient_norm = newton.gradient_norm,

@@ -201,11 +201,7 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
       level.steps.push_back(step_json(step));
       if (finest) {
         frames.push_back(step_json(step));
-        // Settling steps may stop at their budget on the way; the one that ends the settling
-        // must have reached the equilibrium.
-        if (!step.settling || sim.frame_settled())
-          level.converged = level.converged && step.frame.newton.converged &&
-                            (!step.settling || step.equilibrium);
+        if (step.judged) level.converged = level.converged && step.converged;
       }
       std::cerr << fmt::format(
           "{}  level {}/{} frame {}/{}{}: {} iterations, {}, change {:.3e} m/s, {:.3f} s\n",

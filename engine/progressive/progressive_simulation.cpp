@@ -124,18 +124,18 @@ void ProgressiveSimulation::initialize() {
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
-  if (contact_enabled(scene))
-    for (int level = level_count_ - 1; level >= 0; --level) {
-      enter_level(level);
+  if (contact_enabled(scene)) {
+    require_intersection_free(finest_.rest_mesh(), "the rest state", triangle_parts(finest_));
+    for (int level = level_count_ - 2; level >= 0; --level) {
+      const ShellSystem system(scene, level_shells(level));
       require_intersection_free(
-          level_system().rest_mesh(),
-          level + 1 == level_count_
-              ? std::string("the rest state")
-              : fmt::format("level {} of {} of the hierarchy (decimated rest state; use fewer "
-                            "[hierarchy] levels or a larger vertex_ratio)",
-                            level, level_count_),
-          triangle_parts(level_system()));
+          system.rest_mesh(),
+          fmt::format("level {} of {} of the hierarchy (decimated rest state; use fewer "
+                      "[hierarchy] levels or a larger vertex_ratio)",
+                      level, level_count_),
+          triangle_parts(system));
     }
+  }
   enter_level(0);
   x_ = flat(level_system().rest_mesh().vertices);
   previous_ = x_;
@@ -215,6 +215,15 @@ NewtonSettings ProgressiveSimulation::level_newton_settings(int level) const {
   return newton;
 }
 
+std::vector<LevelShellMesh> ProgressiveSimulation::level_shells(int level) const {
+  std::vector<LevelShellMesh> shells;
+  for (const MeshHierarchy& h : hierarchies_) {
+    const HierarchyLevel& shell = h.levels[shell_level(h, level, level_count_)];
+    shells.push_back({shell.rest, shell.pin_group});
+  }
+  return shells;
+}
+
 void ProgressiveSimulation::enter_level(int level) {
   const Scene& scene = finest_.scene();
   stepper_.reset();  // it refers to the level system replaced below
@@ -224,12 +233,7 @@ void ProgressiveSimulation::enter_level(int level) {
         finest_, std::make_unique<LevelObjective>(finest_, scene.time.step),
         level_newton_settings(level));
   } else {
-    std::vector<LevelShellMesh> shells;
-    for (const MeshHierarchy& h : hierarchies_) {
-      const HierarchyLevel& shell = h.levels[shell_level(h, level, level_count_)];
-      shells.push_back({shell.rest, shell.pin_group});
-    }
-    coarse_system_ = std::make_unique<ShellSystem>(scene, shells);
+    coarse_system_ = std::make_unique<ShellSystem>(scene, level_shells(level));
     stepper_ = std::make_unique<LevelStepper>(
         *coarse_system_,
         std::make_unique<ProxyObjective>(*coarse_system_, finest_, to_finest_[level],
@@ -305,6 +309,8 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     if (settled_ && !done) settling_failed_ = true;
     out.equilibrium = done;
     if (done) out.frame.static_residual = out.frame.newton.step_norm;
+    out.judged = finest_level() && settled_;
+    out.converged = out.frame.newton.converged && done;
   } else {
     // The frame's step is the settling schedule's first, at Δt.
     settled_ = !frame_settles(frame);
@@ -312,6 +318,8 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     best_change_ = std::numeric_limits<double>::infinity();
     stalled_steps_ = 0;
     settle_growth_ = next_settling_growth(0, converged_at_start);
+    out.judged = finest_level();
+    out.converged = out.frame.newton.converged;
   }
   return out;
 }

@@ -62,6 +62,11 @@ struct ProgressiveStep {
   /// A settling step that passed the equilibrium test (settling_done): its frame is settled.
   bool equilibrium = false;
   double change = 0.0;  ///< ‖x − xᵗ‖∞/Δt of this step
+  /// Whether the step's verdict counts: a finest-level step, except a settling step on the way
+  /// (which may stop at its budget; the one that ends the settling counts).
+  bool judged = false;
+  /// The verdict: Newton converged and, for a settling step, the equilibrium was reached.
+  bool converged = false;
   /// Frame, time, fine-scale elastic energy (Ψ_L(P^l(x))), Newton history and timings.
   FrameRecord frame;
 };
@@ -151,6 +156,8 @@ class ProgressiveSimulation {
     std::vector<std::array<int, 2>> collapses;  ///< (removed, survivor), level-(l+1) indices
   };
   [[nodiscard]] Expansion system_expansion(int level) const;
+  /// The rest meshes and pin groups of the shells at system level `level` below the finest.
+  [[nodiscard]] std::vector<LevelShellMesh> level_shells(int level) const;
   /// Makes `level` the current level (its system, objective and stepper).
   void enter_level(int level);
   [[nodiscard]] NewtonSettings level_newton_settings(int level) const;

@@ -48,11 +48,8 @@ class ProxyElastics : public ElasticModel {
   /// What the proxy knows at one coarse x, independent of xᵗ and Δt. Filled lazily and
   /// remembered for the last x: a step's report asks for the elastic energy of its final point,
   /// which the line search has just evaluated, and a step that does not move the pins
-  /// (settling) starts where the last one ended. Counted once with temporary counters (not in
-  /// the repository) on `bench_progressive --preview-only 1` (~20k fine vertices), it halves the
-  /// fine energy evaluations (drape 145 → 70, twist 83 → 46, cylinder 46 → 20). The gradient is
-  /// not kept: it is seldom asked twice at one x (kept, the gradient evaluations were 51 → 51,
-  /// 30 → 29, 22 → 20).
+  /// (settling) starts where the last one ended. The gradient is not kept: it is seldom asked
+  /// twice at one x.
   struct FineEvaluation {
     Eigen::VectorXd x;              ///< the key, compared bitwise
     Eigen::VectorXd prolonged;      ///< P^l(x)

@@ -26,9 +26,9 @@ namespace {
 /// The first perturbation moves a cluster's farthest child by g/kPerturbationDivisor: an order
 /// of magnitude below the gap (§4.4.2), so that only the patch itself can intersect.
 constexpr double kPerturbationDivisor = 10.0;
-/// The smallest perturbation, relative to the bounding-box diagonal: IPC leaves gaps far below
-/// d̂ in tight contact (1e-10 m seen), and a perturbation below about 1e-13 of the coordinates is
-/// lost to rounding.
+/// The smallest perturbation, relative to the bounding-box diagonal: IPC can leave gaps far below
+/// d̂ in tight contact, and a perturbation below about 1e-13 of the coordinates is lost to
+/// rounding.
 constexpr double kPerturbationFloor = 1e-7;
 /// Layouts tried per cluster (the target layout, the fitted rest layout, then random rotations
 /// of it) before the cluster is expanded one vertex at a time instead.
@@ -398,9 +398,10 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       place(k, Eigen::Matrix3d::Identity(), radius, Layout::anchors);
     }
     std::set<int> failing;
+    const MixedMesh expanded(surface, representative);  // the layouts move vertices only
     for (int tries = 0;; ++tries) {
       failing.clear();
-      for (int v : intersecting_vertices(MixedMesh(surface, representative), y, surface.may_touch))
+      for (int v : intersecting_vertices(expanded, y, surface.may_touch))
         if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
           failing.insert(parent[v]);
       if (failing.empty() || tries == kClusterLayoutTries) break;
