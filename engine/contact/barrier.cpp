@@ -18,6 +18,18 @@ constexpr double kStiffnessRange = 100;
 
 bool positive_finite(double x) { return x > 0 && std::isfinite(x); }
 
+/// A smallest gap that changed by less than this factor since the last update has stalled.
+constexpr double kStalledGapChange = 2.0;
+
+/// The barrier's push per unit κ across a gap g, |∂b/∂g| = 2 (ξ + g) |b′(s)| with
+/// s = (ξ + g)² − ξ².
+double barrier_push(double gap, const BarrierBand& band) {
+  const double root = band.thickness + gap;
+  return 2 * root *
+         std::abs(barrier_first_derivative(band.barrier_argument(root * root),
+                                           band.barrier_activation()));
+}
+
 }  // namespace
 
 StencilDerivatives<12> barrier_of_distance(const StencilDerivatives<12>& distance,
@@ -63,13 +75,17 @@ BarrierStiffness initial_barrier_stiffness(double bbox_diagonal, const BarrierBa
 BarrierStiffness update_barrier_stiffness(const BarrierStiffness& stiffness,
                                           double previous_min_distance, double min_distance,
                                           double bbox_diagonal, const BarrierBand& band,
-                                          double gap_scale) {
+                                          double gap_scale, bool steps_cut_by_ccd) {
   const double tolerance = gap_scale * bbox_diagonal;
   const double previous_gap = std::sqrt(previous_min_distance) - band.thickness;
   const double gap = std::sqrt(min_distance) - band.thickness;
-  if (previous_gap < tolerance && gap < tolerance && gap < previous_gap)
-    return {std::min(2 * stiffness.value, stiffness.max), stiffness.max};
-  return stiffness;
+  if (!(gap < tolerance)) return stiffness;
+  double factor = previous_gap < tolerance && gap < previous_gap ? 2.0 : 1.0;
+  const bool stalled = previous_gap < tolerance && gap > previous_gap / kStalledGapChange &&
+                       gap < kStalledGapChange * previous_gap;
+  if (steps_cut_by_ccd && stalled)
+    factor = std::max(factor, barrier_push(gap, band) / barrier_push(tolerance, band));
+  return {std::min(factor * stiffness.value, stiffness.max), stiffness.max};
 }
 
 }  // namespace psq

@@ -68,15 +68,24 @@ BarrierStiffness initial_barrier_stiffness(double bbox_diagonal, const BarrierBa
                                            const Eigen::VectorXd& barrier_gradient,
                                            double min_stiffness_scale = 1e11);
 
-/// IPC's stiffness update, once per Newton iteration: when the smallest gap g = √d − ξ over
-/// all pairs was already below ε_g = gap_scale · l (l the bounding-box diagonal) and has
-/// decreased again, the barrier is losing against the other forces and κ doubles:
-///   κ ← min(2κ, κ_max)   if g_prev < ε_g, g < ε_g and g < g_prev;   κ unchanged otherwise.
+/// IPC's stiffness update between Newton iterations, made to catch up with the contact force
+/// where the CCD creeps. IPC doubles κ when the smallest gap g = √d − ξ over all pairs was
+/// already below ε_g = gap_scale · l (l the bounding-box diagonal) and has decreased again.
+/// Doubling is too slow where a stiff structure presses a contact far below ε_g and holds it
+/// there: a crushed aluminium can squeezed a gap to 1e-10 m, and the CCD then cut every
+/// Newton step to 5e-4 of its length for hundreds of iterations. So when the caller reports
+/// that the CCD cut the steps (`steps_cut_by_ccd`) and the gap has stalled below ε_g (it
+/// changed by less than a factor 2 since the last update), κ grows by the ratio of the
+/// barrier's push at g to its push at ε_g, the κ that would hold the same force at ε_g:
+///   κ ← min(f κ, κ_max),   f = max(2 [IPC's rule], |∂b/∂g|(g) / |∂b/∂g|(ε_g) [cut, stalled]).
+/// A small gap alone is no evidence of a large force (a pair a refinement just placed sits
+/// close without pressing), and a gap still falling fast may be a transient of the iteration,
+/// hence the CCD's report and the stall.
 /// `previous_min_distance` and `min_distance` are squared distances (+∞ when no pair is in
-/// reach). With ξ = 0 this is ipc-toolkit's rule d_min < ε_g² on squared distances.
+/// reach). With ξ = 0, ε_g² on squared distances is ipc-toolkit's threshold.
 BarrierStiffness update_barrier_stiffness(const BarrierStiffness& stiffness,
                                           double previous_min_distance, double min_distance,
                                           double bbox_diagonal, const BarrierBand& band,
-                                          double gap_scale = 1e-9);
+                                          double gap_scale = 1e-9, bool steps_cut_by_ccd = false);
 
 }  // namespace psq

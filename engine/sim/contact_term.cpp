@@ -99,12 +99,13 @@ void ContactTerm::initialize_stiffness(const Eigen::VectorXd& x,
   potential_.set_stiffness(stiffness_.value);
 }
 
-bool ContactTerm::update_stiffness(const Eigen::VectorXd& x) {
+bool ContactTerm::update_stiffness(const Eigen::VectorXd& x, bool steps_cut_by_ccd) {
   const double min_distance = potential_.min_distance(x);
   const BarrierBand& band = potential_.parameters().band;
   const double gap_scale = kStiffeningGapFraction * band.activation_distance / bbox_diagonal_;
   const BarrierStiffness updated = update_barrier_stiffness(
-      stiffness_, previous_min_distance_, min_distance, bbox_diagonal_, band, gap_scale);
+      stiffness_, previous_min_distance_, min_distance, bbox_diagonal_, band, gap_scale,
+      steps_cut_by_ccd);
   previous_min_distance_ = min_distance;
   if (fixed_stiffness_ || updated.value == stiffness_.value) return false;
   stiffness_ = updated;

@@ -45,9 +45,10 @@ class ContactTerm : public PotentialTerm {
   void initialize_stiffness(const Eigen::VectorXd& x, const Eigen::VectorXd& base_gradient,
                             const std::vector<bool>& free, double inertia_weight);
   /// IPC's update between Newton iterations (update_barrier_stiffness): doubles κ (up to κ_max)
-  /// when the smallest gap stays below ε_g = 1e-2 d̂ and shrank since the last call. Returns
-  /// whether κ changed.
-  bool update_stiffness(const Eigen::VectorXd& x);
+  /// when the smallest gap stays below ε_g = 1e-2 d̂ and shrank since the last call, and when
+  /// `steps_cut_by_ccd` (the CCD cut most of the last steps short) raises it to hold the
+  /// contact force at ε_g. Returns whether κ changed.
+  bool update_stiffness(const Eigen::VectorXd& x, bool steps_cut_by_ccd);
 
   /// Adds κ, its upper bound and the last smallest distance to `state` ("contact.*").
   void save_state(std::map<std::string, double>& state) const;

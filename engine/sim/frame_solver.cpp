@@ -13,8 +13,10 @@ namespace {
 
 /// Penalty stiffness k of the first pull round, its growth per round and the rounds tried
 /// before a frame gives up on reaching its targets (the scripted vertices then stay where the
-/// last round left them, a safe state, and the next frame tries again).
-constexpr double kInitialPullStiffness = 1e4;
+/// last round left them, a safe state, and the next frame tries again). With the weights of
+/// pull_weight, k = 1 already holds a pulled vertex as firmly as the stiffest shell's membrane
+/// holds its own, so one round usually brings the targets within a safe direct move.
+constexpr double kInitialPullStiffness = 1.0;
 constexpr double kPullGrowth = 100.0;
 constexpr int kMaxPullRounds = 6;
 
@@ -23,8 +25,36 @@ constexpr int kMaxPullRounds = 6;
 /// may only change between).
 constexpr int kStiffnessUpdateInterval = 10;
 
+/// A step whose CCD bound is below this fraction of the Newton step creeps: a pair ahead of it
+/// is so close that the barrier, too weak for the force pressing it, lets Newton aim through.
+constexpr double kCreepingStep = 0.1;
+
 /// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
 constexpr int kMaxFrictionIterations = 5;
+
+/// The stiffest in-plane stiffness of the scene's shells, E h / (1 − ν²) (N/m): the stiffness
+/// of a membrane triangle against stretching, whatever its size.
+double stiffest_membrane(const Scene& scene) {
+  double stiffest = 0.0;
+  for (const Shell& shell : scene.shells) {
+    const Material& m = shell.material;
+    stiffest = std::max(stiffest, m.youngs_modulus * m.thickness /
+                                      (1.0 - m.poisson_ratio * m.poisson_ratio));
+  }
+  return stiffest;
+}
+
+/// Whether the CCD cut at least half of a solve's steps short (kCreepingStep).
+bool steps_cut_by_ccd(const NewtonResult& solve) {
+  int steps = 0;
+  int cut = 0;
+  for (const NewtonIteration& it : solve.history) {
+    if (it.line_search_trials == 0) continue;
+    ++steps;
+    if (it.feasible_step < kCreepingStep) ++cut;
+  }
+  return steps > 0 && 2 * cut >= steps;
+}
 
 }  // namespace
 
@@ -91,6 +121,7 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
   system_.apply_pins(target, record.time);
   std::vector<int> pulled, held;
   std::vector<double> weights;
+  const double structural_weight = stiffest_membrane(system_.scene());
   for (const PinnedVertex& p : system_.pinned()) {
     if (target.segment<3>(3 * p.vertex) == x.segment<3>(3 * p.vertex)) {
       held.push_back(p.vertex);
@@ -98,7 +129,7 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
     }
     pulled.push_back(p.vertex);
     const double mass = std::max(system_.dof_masses()[3 * p.vertex], contact_->average_mass());
-    weights.push_back(potential_.inertia_weight() * mass);
+    weights.push_back(std::max(potential_.inertia_weight() * mass, structural_weight));
   }
   pull_.set(std::move(pulled), target, std::move(weights));
   potential_.add_term(pull_);
@@ -135,16 +166,21 @@ NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs
   NewtonSettings chunk = settings;
   while (true) {
     chunk.max_iterations = std::min(interval, settings.max_iterations - done);
+    // An inner chunk's last iterate is judged by the next chunk's first iteration, which
+    // assembles and factorizes there anyway: judging it here too would do that twice.
+    chunk.judge_final_iterate =
+        done + chunk.max_iterations < settings.max_iterations ? false : settings.judge_final_iterate;
     NewtonResult part = newton_.minimize(potential_, x, dofs, chunk, numbered);
     done += part.iterations;
+    const bool creeping = steps_cut_by_ccd(part);
     append_solve(total, std::move(part));
     if (total.converged || total.stagnated || done >= settings.max_iterations) return total;
-    update_stiffnesses(x);
+    update_stiffnesses(x, creeping);
   }
 }
 
-void FrameSolver::update_stiffnesses(const Eigen::VectorXd& x) {
-  if (contact_) contact_->update_stiffness(x);
+void FrameSolver::update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd) {
+  if (contact_) contact_->update_stiffness(x, steps_cut_by_ccd);
   if (strain_limit_) strain_limit_->update_stiffness(x);
 }
 

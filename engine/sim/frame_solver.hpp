@@ -119,7 +119,7 @@ class FrameSolver {
                                const NewtonSettings& settings,
                                const NewtonSolver::Progress& progress);
   /// IPC's κ update and Codim-IPC's κ_s update at x, for the terms the scene has.
-  void update_stiffnesses(const Eigen::VectorXd& x);
+  void update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd);
 
   const ShellSystem& system_;
   IncrementalPotential& potential_;

@@ -2,11 +2,15 @@
 // How scripted vertices (pinned shell sets, collider vertices) reach their targets safely when
 // contact is on. Moving them directly could push a collider through a shell, so when the CCD
 // says the direct move is not safe, they become unknowns pulled toward their targets by
-//   P(x) = ½ k Σᵢ wᵢ ‖xᵢ − yᵢ‖²,   wᵢ = mᵢ/Δt²,
+//   P(x) = ½ k Σᵢ wᵢ ‖xᵢ − yᵢ‖²,   wᵢ = max(mᵢ/Δt², E h/(1 − ν²)),
 // and the solver's CCD line search keeps every iterate intersection-free (IPC's treatment of
 // kinematic boundary conditions, with a penalty of growing stiffness k in place of the
-// augmented Lagrangian's multipliers). Once the rest of the way is safe they are pinned at the
-// targets; see QuasistaticSimulation.
+// augmented Lagrangian's multipliers). IPC weighs by mass alone, which suits dynamics; in a
+// quasistatic solve the inertia is tiny beside the elastic forces, and a plate pulled that
+// softly against a stiff can lags far behind its target for several rounds, each a full
+// solve. The floor E h/(1 − ν²), the stiffest shell's membrane stiffness, makes the pull as
+// firm as the structure it presses. Once the rest of the way is safe they are pinned at the
+// targets; see FrameSolver.
 
 #include <vector>
 

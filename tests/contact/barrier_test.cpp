@@ -190,7 +190,7 @@ TEST(BarrierStiffness, RefusesNonPositiveScales) {
 }
 
 TEST(BarrierStiffness, DoublesOnlyWhileTheMinimumGapKeepsShrinkingBelowTheTolerance) {
-  // l = 2: the gap tolerance is 2e-9.
+  // l = 2: the gap tolerance is 2e-9. The CCD did not cut the steps: IPC's rule alone.
   const BarrierStiffness k{1e6, 1e8};
   const auto update = [&](double previous_gap, double gap, double thickness = 0) {
     const BarrierBand band{1e-3, thickness};
@@ -209,6 +209,48 @@ TEST(BarrierStiffness, DoublesOnlyWhileTheMinimumGapKeepsShrinkingBelowTheTolera
   EXPECT_EQ(update_barrier_stiffness(k, kInfinity, kInfinity, 2, {1e-3, 0}).value, 1e6);
   // Never beyond κ_max.
   EXPECT_EQ(update_barrier_stiffness({0.7e8, 1e8}, 1e-18, 0.5e-18, 2, {1e-3, 0}).value, 1e8);
+}
+
+/// |∂b/∂g| across a gap g for ŝ = d̂² (ξ = 0), from IPC's b(s) = −(s − ŝ)² ln(s/ŝ) with s = g²,
+/// differentiated by hand: ∂b/∂s = −2 (s − ŝ) ln(s/ŝ) − (s − ŝ)²/s.
+double push_across(double gap, double activation) {
+  const double s = gap * gap;
+  const double s_hat = activation * activation;
+  return 2 * gap * std::abs(-2 * (s - s_hat) * std::log(s / s_hat) - (s - s_hat) * (s - s_hat) / s);
+}
+
+TEST(BarrierStiffness, CatchesUpWithTheForceWhereTheCcdCutsStepsAtAStalledGap) {
+  // l = 2: the gap tolerance is 2e-9; d̂ = 1e-3.
+  const BarrierStiffness k{1e6, 1e15};
+  const double tolerance = 2e-9;
+  const auto cut = [&](double previous_gap, double gap) {
+    return update_barrier_stiffness(k, previous_gap * previous_gap, gap * gap, 2, {1e-3, 0},
+                                    1e-9, true)
+        .value;
+  };
+  const auto held_at_tolerance = [&](double gap) {
+    return 1e6 * push_across(gap, 1e-3) / push_across(tolerance, 1e-3);
+  };
+  // Stuck far below the tolerance (the crushed can's 1e-10 m gaps): one update catches up,
+  // by about the gap ratio 2e-9 / 1e-12.
+  EXPECT_NEAR(cut(1e-12, 1e-12), held_at_tolerance(1e-12), 1e-9 * held_at_tolerance(1e-12));
+  EXPECT_GT(cut(1e-12, 1e-12), 1e3 * 1e6);
+  // Stalled while creeping up slowly: the push ratio alone (about 4/3), no doubling.
+  EXPECT_NEAR(cut(1e-9, 1.5e-9), held_at_tolerance(1.5e-9), 1e-9 * 1e6);
+  EXPECT_LT(cut(1e-9, 1.5e-9), 1.5e6);
+  // Stalled and shrinking a little: at least IPC's doubling.
+  EXPECT_NEAR(cut(1.2e-9, 1e-9), std::max(2e6, held_at_tolerance(1e-9)), 1e-9 * 2e6);
+  // Falling fast (a transient of the iteration, not a held contact): IPC's doubling only.
+  EXPECT_EQ(cut(1.5e-9, 1e-12), 2e6);
+  // Recovering (the gap at least doubled): unchanged.
+  EXPECT_EQ(cut(0.5e-9, 1e-9), 1e6);
+  // Just fell below the tolerance: nothing is stalled yet.
+  EXPECT_EQ(cut(3e-9, 1e-9), 1e6);
+  // At or above the tolerance: unchanged.
+  EXPECT_EQ(cut(1e-8, tolerance), 1e6);
+  // Never beyond κ_max.
+  EXPECT_EQ(update_barrier_stiffness({1e6, 1e7}, 1e-24, 1e-24, 2, {1e-3, 0}, 1e-9, true).value,
+            1e7);
 }
 
 }  // namespace

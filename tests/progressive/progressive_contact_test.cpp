@@ -21,7 +21,9 @@ namespace psq {
 namespace {
 
 /// A sheet held at its rim, pressed by a descending sphere (bunny_press with a sphere): the
-/// frames are equilibria, and the pressed shape is unique.
+/// frames are equilibria, and the pressed shape is unique up to the barrier's band: two solves
+/// whose κ differ rest at gaps anywhere within d̂, so d̂ (0.27e-3 of the diagonal) is kept
+/// below the 1e-3 of the diagonal by which the progressive and direct answers must agree.
 constexpr const char* kPress = R"(
 name = "press"
 gravity = [0, 0, -9.81]
@@ -29,7 +31,7 @@ gravity = [0, 0, -9.81]
 step = 0.04
 frames = 10
 [contact]
-activation_distance = 1e-3
+activation_distance = 2e-4
 [[shell]]
 name = "sheet"
 mesh = { generator = "sheet", width = 0.5, height = 0.5, edge_length = 0.04 }
