@@ -4,7 +4,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fmt/format.h>
-#include <fstream>
+#include <sstream>
 #include <unistd.h>
 
 #include "engine/core/error.hpp"
@@ -20,6 +20,25 @@ std::string fsync_path(const std::filesystem::path& path, int flags) {
   const int error = errno;
   ::close(fd);
   return synced ? std::string() : std::strerror(error);
+}
+
+/// Creates `file` and writes `bytes` to it through a file descriptor, so that a failure is
+/// reported with the system's own reason (disk full, read-only file system, permission
+/// denied, file too large) rather than a stream's bare failure flag. The reason, or empty.
+std::string write_new_file(const std::filesystem::path& file, std::string_view bytes) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return std::strerror(errno);
+  while (!bytes.empty()) {
+    const ssize_t written = ::write(fd, bytes.data(), bytes.size());
+    if (written < 0 && errno == EINTR) continue;
+    if (written < 0) {
+      const int error = errno;
+      ::close(fd);
+      return std::strerror(error);
+    }
+    bytes.remove_prefix(static_cast<std::size_t>(written));
+  }
+  return ::close(fd) == 0 ? std::string() : std::strerror(errno);
 }
 
 }  // namespace
@@ -53,16 +72,18 @@ void replace_file_atomically(const std::filesystem::path& path,
                                  dir_error));
 }
 
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
+    if (const std::string error = write_new_file(temporary, bytes); !error.empty())
+      throw InputError(fmt::format("cannot write '{}': {}", path.string(), error));
+  });
+}
+
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(std::ostream&)>& write) {
-  replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out)
-      throw InputError(fmt::format("cannot write '{}': {}", path.string(), std::strerror(errno)));
-    write(out);
-    out.flush();
-    if (!out) throw InputError(fmt::format("cannot write '{}': write failed (disk full?)", path.string()));
-  });
+  std::ostringstream content;
+  write(content);
+  write_file_atomically(path, content.view());
 }
 
 }  // namespace psq

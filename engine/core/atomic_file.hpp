@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <string_view>
 
 namespace psq {
 
@@ -15,7 +16,12 @@ namespace psq {
 void replace_file_atomically(const std::filesystem::path& path,
                              const std::function<void(const std::filesystem::path&)>& produce);
 
-/// replace_file_atomically for content written to a stream.
+/// replace_file_atomically for bytes in memory. The InputError of a failed write names `path`
+/// and the system's reason ("No space left on device", "Read-only file system", ...).
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+/// write_file_atomically for content written to a stream (collected in memory, then written as
+/// above).
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(std::ostream&)>& write);
 
