@@ -15,7 +15,6 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <span>
-#include <stdexcept>
 #include <utility>
 
 #include "engine/core/checksum.hpp"
@@ -315,18 +314,6 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   return c;
 }
 
-/// The FNV-1a 64 checksum of a file's bytes.
-std::uint64_t file_checksum(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(fmt::format("cannot reopen: {}", std::strerror(errno)));
-  Fnv1a64 hash;
-  std::vector<char> block(std::size_t{1} << 16);
-  while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0)
-    hash.update(std::as_bytes(std::span(block.data(), static_cast<std::size_t>(in.gcount()))));
-  if (in.bad()) throw std::runtime_error("read error");
-  return hash.value();
-}
-
 std::vector<char> read_bytes(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code error;
@@ -351,11 +338,14 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
   try {
     std::uint64_t checksum = 0;
     replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
-      {
-        const std::lock_guard lock(hdf5_mutex());
-        encode(checkpoint, temporary);
-      }
-      checksum = file_checksum(temporary);
+      const std::lock_guard lock(hdf5_mutex());
+      encode(checkpoint, temporary);
+      // Reading the file back proves that HDF5 wrote all of it: a write it held back and lost
+      // without an error (as its dataset buffer once did on a full disk) must not replace the
+      // previous checkpoint.
+      const std::vector<char> bytes = read_bytes(temporary);
+      decode(temporary.string(), bytes);
+      checksum = fnv1a64(std::as_bytes(std::span(bytes)));
     });
     return checksum;
   } catch (const std::exception& e) {

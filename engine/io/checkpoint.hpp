@@ -97,13 +97,14 @@ inline constexpr std::string_view triangles = "/mesh/triangles";
 inline constexpr std::string_view finest_positions = "/mesh/finest_positions";
 }  // namespace checkpoint_layout
 
-/// Writes `checkpoint` to `path` atomically: the file is built in memory, written to a temporary
-/// name in the same directory, flushed to disk (fsync) and renamed over `path`, so `path` is
-/// always either the previous file or the complete new one. Stores a checksum of the content
-/// (every attribute and dataset) inside the file. Returns the FNV-1a 64 checksum of the bytes of
-/// the written file, for the store to record. Throws CheckpointError naming `path` if the
-/// checkpoint is inconsistent (shapes, triangle indices, non-finite values, parameters that are
-/// not JSON) or cannot be written; the previous file is then left as it was.
+/// Writes `checkpoint` to `path` atomically: the file is written to a temporary name in the
+/// same directory, read back and verified, flushed to disk (fsync) and renamed over `path`, so
+/// `path` is always either the previous file or the complete new one. Stores a checksum of the
+/// content (every attribute and dataset) inside the file. Returns the FNV-1a 64 checksum of the
+/// bytes of the written file, for the store to record. Throws CheckpointError naming `path` if
+/// the checkpoint is inconsistent (shapes, triangle indices, non-finite values, parameters that
+/// are not JSON) or cannot be written (the system's reason, e.g. "No space left on device");
+/// the previous file is then left as it was.
 std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
 
 /// Reads and verifies a checkpoint: the file's checksum against `expected_file_checksum` when

@@ -72,13 +72,25 @@ herr_t keep_first_description(unsigned, const H5E_error2_t* entry, void* sink) {
   return 0;
 }
 
+/// The system's message in a description of HDF5's file driver, which tells of a failed system
+/// call at length (its time, over two lines, the descriptor, buffer address and sizes); the
+/// description itself if it has none.
+std::string system_message(const std::string& description) {
+  constexpr std::string_view marker = "error message = '";
+  const std::size_t start = description.find(marker);
+  if (start == std::string::npos) return description;
+  const std::size_t end = description.find('\'', start + marker.size());
+  if (end == std::string::npos) return description;
+  return description.substr(start + marker.size(), end - start - marker.size());
+}
+
 /// The most specific description on HDF5's error stack (where the failure was detected), after
 /// which the stack is cleared.
 std::string innermost_reason() {
   std::string reason;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_first_description, &reason);
   H5Eclear2(H5E_DEFAULT);
-  return reason.empty() ? "no detail from HDF5" : reason;
+  return reason.empty() ? "no detail from HDF5" : system_message(reason);
 }
 
 [[noreturn]] void fail(const std::string& file, const std::string& object, std::string_view what) {
@@ -168,6 +180,9 @@ void Group::write_dataset(std::string_view name, std::span<const T> values,
   if (count > 0 &&
       H5Dwrite(dataset.get(), Types<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
     hdf5_failure(path, "cannot write dataset");
+  // HDF5 may hold the values back (its sieve buffer) until the dataset closes: a write that
+  // fails then (disk full) is only reported by the close.
+  if (!dataset.close()) hdf5_failure(path, "cannot write dataset");
 }
 
 template <Element T>
