@@ -368,12 +368,13 @@ void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& er
   transaction.commit();
 }
 
-bool JobStore::release(const Lease& lease) {
+bool JobStore::release(const Lease& lease, const std::string& reason) {
+  // A clean release leaves the error alone: it still tells of the last failure, if any.
   return connection_
-             .prepare(fmt::format(
-                 "UPDATE jobs SET {} WHERE id = ?1 AND attempt = ?2 AND state = 'running'",
-                 kBackToTheQueue))
-             .bind_all(lease.job_id, lease.attempt)
+             .prepare(fmt::format("UPDATE jobs SET {}, error = COALESCE(?3, error) "
+                                  "WHERE id = ?1 AND attempt = ?2 AND state = 'running'",
+                                  kBackToTheQueue))
+             .bind_all(lease.job_id, lease.attempt, unless_empty(reason))
              .run() == 1;
 }
 

@@ -77,9 +77,10 @@ class JobStore {
   /// Ends the attempt: done, or failed with `error` (queued again while failures stay below
   /// max_attempts, unless permanent). Throws LeaseLostError if the lease is lost.
   void finish(const Lease& lease, Outcome outcome, const std::string& error = {});
-  /// Gives the job back to the queue without counting a failure (clean shutdown). False if
-  /// the lease was already lost.
-  bool release(const Lease& lease);
+  /// Gives the job back to the queue without counting a failure: a clean shutdown, or an
+  /// attempt stopped by its environment (a file it could not write), whose `reason` is then
+  /// kept as the job's error until the job finishes. False if the lease was already lost.
+  bool release(const Lease& lease, const std::string& reason = {});
 
   /// Cancels the selected queued or running jobs; returns how many. A running job's worker
   /// learns it from its next heartbeat.

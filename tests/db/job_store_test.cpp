@@ -332,6 +332,34 @@ TEST(JobStoreRetries, ReleaseRequeuesWithoutAFailureAndNeverReusesTheToken) {
   EXPECT_THROW(store.finish(first->lease, Outcome::done), LeaseLostError);
 }
 
+TEST(JobStoreRetries, ReleaseWithAReasonKeepsItUntilTheJobIsDone) {
+  ManualClock clock;
+  JobStore store(fresh_store_path(), clock.options());
+  store.add_sweep("s", "s.toml", thickness_jobs(0, 1, 3, /*max_attempts=*/1));
+  const auto first = store.claim_next(worker("w"), 30);
+  ASSERT_TRUE(first);
+  const std::string reason = "cannot write '/runs/j/level_0.h5': No space left on device";
+  EXPECT_TRUE(store.release(first->lease, reason));
+  Job job = *store.find_job("job-0000");
+  EXPECT_EQ(job.state, JobState::queued);
+  EXPECT_EQ(job.failures, 0);
+  EXPECT_EQ(job.error, reason);
+  ASSERT_EQ(store.failures(JobSelection::all()).size(), 1u);  // psq status shows it
+
+  // A clean release (a stop on request) leaves the reason; finishing clears it.
+  const auto second = store.claim_next(worker("w"), 30);
+  ASSERT_TRUE(second);
+  EXPECT_TRUE(store.release(second->lease));
+  EXPECT_EQ(store.find_job("job-0000")->error, reason);
+  const auto third = store.claim_next(worker("w"), 30);
+  ASSERT_TRUE(third);
+  store.finish(third->lease, Outcome::done);
+  job = *store.find_job("job-0000");
+  EXPECT_EQ(job.state, JobState::done);
+  EXPECT_EQ(job.error, "");
+  EXPECT_TRUE(store.integrity_problems().empty());
+}
+
 TEST(JobStoreRetries, RetryRequeuesFailedJobsWithFailuresReset) {
   ManualClock clock;
   JobStore store(fresh_store_path(), clock.options());
