@@ -327,10 +327,22 @@ class JobRun {
   void snapshot(LevelProgress progress, int frame, int iterations_in_frame) {
     const int level = solver_->level();
     const fs::path file = run_.snapshot(level);
-    std::error_code ignored;
-    if (fs::exists(file)) fs::rename(file, run_.previous_snapshot(level), ignored);
-    const std::uint64_t checksum =
-        write(file, make_checkpoint(progress, frame, iterations_in_frame));
+    const fs::path previous = run_.previous_snapshot(level);
+    std::error_code error;
+    bool kept = false;
+    if (fs::exists(file)) {
+      fs::rename(file, previous, error);
+      kept = !error;
+    }
+    std::uint64_t checksum = 0;
+    try {
+      checksum = write(file, make_checkpoint(progress, frame, iterations_in_frame));
+    } catch (...) {
+      // The latest snapshot goes back under the name the store's record of the level gives it,
+      // so that a resume verifies it against the recorded checksum.
+      if (kept) fs::rename(previous, file, error);
+      throw;
+    }
     test_point("snapshot_written");
     record(db::LevelStatus::running, file, checksum);
     test_point("snapshot_recorded");
@@ -440,16 +452,21 @@ class JobRun {
     return RunOutcome::failed;
   }
 
+  /// The job's files cannot be written (disk full, read-only, no permission): not the job's
+  /// fault, and every other job would fail alike. The attempt is released with the reason (no
+  /// failure counted), and the worker is told to stop.
   WorkerEnvironmentError environment_failure(const std::string& what) {
+    const std::string reason = fmt::format(
+        "attempt {} stopped: {}; the job was released without counting a failure: free disk "
+        "space or make the directory writable, then run psq work, and the job continues from "
+        "its last checkpoint",
+        claim_.lease.attempt, what);
     try {
-      store_.release(claim_.lease);
+      store_.release(claim_.lease, reason);
     } catch (const std::exception&) {
       // The store may share the failing disk; the lease then expires instead.
     }
-    return WorkerEnvironmentError(fmt::format(
-        "{} (job {} released; fix the output directory or free disk space, then run psq work "
-        "again)",
-        what, claim_.job.id));
+    return WorkerEnvironmentError(fmt::format("job {}: {}", claim_.job.id, reason));
   }
 
   void log(const std::string& line) const {

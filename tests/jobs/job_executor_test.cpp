@@ -4,7 +4,9 @@
 
 #include "jobs/job_executor.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <thread>
@@ -316,6 +318,53 @@ TEST_F(Executor, AnUnwritableRunsDirectoryReleasesTheJobAndStopsTheWorker) {
   const db::JobResult r = result();
   EXPECT_EQ(r.job.state, db::JobState::queued);
   EXPECT_EQ(r.job.failures, 0);
+}
+
+TEST_F(Executor, ASnapshotThatCannotBeWrittenKeepsTheRecordedOneAndTheJobResumesExactly) {
+  // A directory in the way of the snapshot's temporary (replace_file_atomically's
+  // ".<name>.tmp<pid>") fails the write with EISDIR, like a full or read-only disk would: at
+  // progress event 7 (frame 2, step 1: a snapshot is due), after the snapshot of frame 1 step 4.
+  const fs::path obstacle =
+      run_dir().dir() / fmt::format(".{}.tmp{}", run_dir().snapshot(0).filename().string(),
+                                    ::getpid());
+  const auto block_at_seven = [&](int n) {
+    if (n != 7) return;
+    fs::create_directories(obstacle);
+    test::write_file(obstacle / "in_the_way", "so that the failed write cannot remove it");
+  };
+  const std::string snapshot = run_dir().snapshot(0).string();
+  try {
+    run(block_at_seven);
+    FAIL() << "expected WorkerEnvironmentError";
+  } catch (const jobs::WorkerEnvironmentError& error) {
+    EXPECT_NE(std::string(error.what()).find(snapshot), std::string::npos) << error.what();
+  }
+  const db::JobResult stopped = result();
+  EXPECT_EQ(stopped.job.state, db::JobState::queued);
+  EXPECT_EQ(stopped.job.failures, 0);
+  EXPECT_NE(stopped.job.error.find("attempt 1 stopped: "), std::string::npos) << stopped.job.error;
+  EXPECT_NE(stopped.job.error.find(snapshot), std::string::npos) << stopped.job.error;
+  EXPECT_NE(stopped.job.error.find("Is a directory"), std::string::npos) << stopped.job.error;
+  // The store's record still names the previous snapshot, which verifies against its checksum.
+  ASSERT_EQ(stopped.levels.size(), 1u);
+  const db::LevelRecord& record = stopped.levels[0];
+  EXPECT_EQ(record.status, db::LevelStatus::running);
+  EXPECT_EQ(fs::path(record.checkpoint_path), fs::absolute(snapshot));
+  const auto checksum = parse_checksum(record.checkpoint_checksum);
+  ASSERT_TRUE(checksum);
+  const Checkpoint kept = read_checkpoint(snapshot, *checksum);
+  EXPECT_EQ(kept.frame, 1);
+  EXPECT_EQ(kept.solver.iterations_in_frame, 4);
+  EXPECT_TRUE(db::JobStore(dir() / "psq.db").integrity_problems().empty());
+
+  fs::remove_all(obstacle);
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  EXPECT_NE(log.find("resuming level 0 frame 1 from level_0.snapshot.h5"), std::string::npos)
+      << log;
+  const db::JobResult finished = result();
+  EXPECT_EQ(finished.job.state, db::JobState::done);
+  EXPECT_EQ(finished.job.error, "");
+  expect_same_as_reference(final_checkpoint());
 }
 
 TEST_F(Executor, ACancelledJobStopsAtItsNextHeartbeat) {

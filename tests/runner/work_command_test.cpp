@@ -205,7 +205,13 @@ TEST_F(WorkCommand, AFullDiskStopsTheWorkerCleanlyAndTheWorkResumesLater) {
   EXPECT_NE(child.errors().find("File too large"), std::string::npos) << child.errors();
   EXPECT_NE(child.errors().find("released"), std::string::npos) << child.errors();
   expect_store_consistent();
-  EXPECT_EQ(results().front().job.state, db::JobState::queued);
+  const db::Job stopped = results().front().job;
+  EXPECT_EQ(stopped.state, db::JobState::queued);
+  EXPECT_EQ(stopped.failures, 0);
+  // The attempt says which file it could not write, and why.
+  const std::string run_dir = fs::absolute(dir_ / ".psq" / "runs" / stopped.id).string();
+  EXPECT_NE(stopped.error.find(run_dir + "/level_0."), std::string::npos) << stopped.error;
+  EXPECT_NE(stopped.error.find("File too large"), std::string::npos) << stopped.error;
   const auto resumed = psq({"resume", "w", "--workers", "1"});
   EXPECT_EQ(resumed.exit_code, 0) << resumed.errors;
   for (const db::JobResult& r : results()) EXPECT_EQ(r.job.state, db::JobState::done);
