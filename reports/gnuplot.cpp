@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 
+#include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
 #include "reports/child_process.hpp"
 #include "reports/html_text.hpp"
@@ -32,6 +32,17 @@ const char* style_name(PlotSpec::Style style) {
       return "linespoints lw 1.5 pt 7 ps 0.6";
   }
   return "linespoints";
+}
+
+/// Throws InputError with the file system's reason if `scratch` has no room left: gnuplot says
+/// nothing when it cannot write a plot (a full disk), so a missing plot is put to the file system
+/// before gnuplot is blamed.
+void require_room(const std::filesystem::path& scratch, const std::string& title) {
+  try {
+    write_file_atomically(scratch / "room", std::string(4096, ' '));
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("gnuplot could not draw the plot '{}' ({})", title, error.what()));
+  }
 }
 
 }  // namespace
@@ -82,11 +93,10 @@ std::vector<std::string> Gnuplot::render_svgs(const std::vector<PlotSpec>& plots
   const int run = runs_++;
   const auto image = [&](std::size_t p) { return scratch_ / fmt::format("run{}-{}.svg", run, p); };
   const std::filesystem::path script = scratch_ / fmt::format("run{}.gp", run);
-  {
-    std::ofstream out(script);
+  write_file_atomically(script, [&](std::ostream& out) {
     for (std::size_t p = 0; p < plots.size(); ++p)
       out << gnuplot_script(plots[p], image(p)) << "reset\n";
-  }
+  });
   ChildExit exit;
   try {
     exit = run_child(program_, {script.string()}, scratch_ / fmt::format("run{}.err", run));
@@ -103,9 +113,11 @@ std::vector<std::string> Gnuplot::render_svgs(const std::vector<PlotSpec>& plots
   std::vector<std::string> svgs;
   for (std::size_t p = 0; p < plots.size(); ++p) {
     svgs.push_back(read_child_output(image(p)));
-    if (svgs.back().find("</svg>") == std::string::npos)
+    if (svgs.back().find("</svg>") == std::string::npos) {
+      require_room(scratch_, plots[p].title);
       throw Error(fmt::format("gnuplot ('{}') did not draw the plot '{}': {}", program_,
                               plots[p].title, exit.errors));
+    }
   }
   return svgs;
 }

@@ -7,8 +7,8 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 
+#include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
 
 namespace psq::reports {
@@ -96,14 +96,25 @@ void publish_directory(const std::filesystem::path& target,
   if (!std::filesystem::create_directory(built, error) || error)
     throw InputError(fmt::format("cannot write a report to '{}': {}", target.string(),
                                  error ? error.message() : "a temporary directory is in the way"));
+  // The report is built whole before it replaces anything: until then, a failure (a file that
+  // cannot be written on a full or read-only disk, and the like) leaves `target` as it was.
+  const auto failed = [&](const std::string& why) {
+    std::filesystem::remove_all(built, error);
+    return InputError(fmt::format("cannot write a report to '{}': {}; '{}' is left as it was",
+                                  target.string(), why, target.string()));
+  };
   try {
     fill(built);
-    std::ofstream marker(built / kReportMarker);
-    marker << "written by psq report\n";
-    marker.close();
-    if (!marker)
-      throw InputError(fmt::format("cannot write '{}': write failed (disk full?)",
-                                   (target / kReportMarker).string()));
+    write_file_atomically(built / kReportMarker, std::string_view("written by psq report\n"));
+  } catch (const InputError& e) {
+    throw failed(e.what());
+  } catch (const std::filesystem::filesystem_error& e) {
+    throw failed(e.what());
+  } catch (...) {
+    std::filesystem::remove_all(built, error);
+    throw;
+  }
+  try {
     const bool replaced = move_into_place(built, path);
     sync_directory(path.parent_path());
     if (replaced) std::filesystem::remove_all(built, error);

@@ -17,7 +17,8 @@ inline constexpr const char* kReportMarker = ".psq-report";
 /// report, whose old content is then removed. If anything fails — including `fill` — the
 /// temporary directory is removed and `target` is left as it was. Throws InputError naming
 /// `target` if it exists but is not a directory, is a non-empty directory without the marker,
-/// or cannot be written; exceptions from `fill` propagate.
+/// or cannot be written, and for an InputError or file system error from `fill` (its message
+/// inside); other exceptions from `fill` propagate.
 void publish_directory(const std::filesystem::path& target,
                        const std::function<void(const std::filesystem::path&)>& fill);
 

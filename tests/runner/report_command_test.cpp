@@ -1,13 +1,16 @@
 // `psq report` end to end on the report fixture store: the files and their content, and bad
-// input (unknown sweep, missing store, unwritable --out) with exit 1 and nothing written.
+// input (unknown sweep, missing store, unwritable --out, a full or read-only disk) with exit 1
+// and nothing written.
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "reports/report_fixture.hpp"
 #include "support/run_process.hpp"
+#include "support/small_filesystem.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -118,6 +121,44 @@ TEST_F(ReportCommand, AnUnwritableOutExitsOneAndLeavesNothingHalfWritten) {
   expected.push_back("blocker");
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(entries(dir_), expected);
+}
+
+TEST_F(ReportCommand, AFullOrReadOnlyDiskLeavesThePreviousReportWhole) {
+  const auto disk_dir = dir_ / "disk";
+  const test::SmallFilesystem disk(disk_dir, 4 << 20);
+  if (!disk.refusal().empty()) GTEST_SKIP() << disk.refusal();
+  const auto out = disk_dir / "report";
+  ASSERT_EQ(psq({"report", "plates", "--out", out.string()}).exit_code, 0);
+  std::map<std::string, std::string> previous;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
+    if (entry.is_regular_file()) previous[entry.path().string()] = test::read_file(entry.path());
+  const auto expect_refused_and_kept = [&](const std::string& reason) {
+    const auto result = psq({"report", "plates", "--out", out.string()});
+    EXPECT_EQ(result.exit_code, 1) << result.errors;
+    EXPECT_NE(result.errors.find("cannot write a report to '" + out.string() + "'"),
+              std::string::npos)
+        << result.errors;
+    EXPECT_NE(result.errors.find(reason), std::string::npos) << result.errors;
+    std::size_t files = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
+      if (entry.is_regular_file()) {
+        ++files;
+        EXPECT_EQ(test::read_file(entry.path()), previous[entry.path().string()]) << entry.path();
+      }
+    EXPECT_EQ(files, previous.size());
+  };
+  // The disk fills up in the tables, in the plots (gnuplot says nothing then) and in the page.
+  for (const std::size_t spare : {0, 24 << 10, 64 << 10, 128 << 10}) {
+    SCOPED_TRACE(spare);
+    disk.fill(spare);
+    expect_refused_and_kept("No space left on device");
+    EXPECT_EQ(entries(disk_dir), (std::vector<std::string>{".filler", "report"}));
+    disk.free_space();
+  }
+  disk.set_read_only(true);
+  expect_refused_and_kept("Read-only file system");
+  disk.set_read_only(false);
+  EXPECT_EQ(psq({"report", "plates", "--out", out.string()}).exit_code, 0);
 }
 
 TEST_F(ReportCommand, AMissingGnuplotExitsOneWithTheFixAndWritesNothing) {
