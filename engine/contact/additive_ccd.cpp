@@ -79,11 +79,44 @@ CcdResult advance(const PairPositions& start, const PairPositions& displacement,
     t = next_t;
     gap = next_gap;
     if (t >= settings.t_max) return {false, settings.t_max, iteration};
+    if (t >= settings.stop_after) return {false, t, iteration};
   }
   return {true, t, settings.max_iterations};
 }
 
+/// l_p of a point–triangle pair: |Δp| + maxᵢ |Δtᵢ|.
+double point_triangle_speed_bound(const PairPositions& displacement) {
+  return displacement[0].norm() +
+         std::max({displacement[1].norm(), displacement[2].norm(), displacement[3].norm()});
+}
+
+/// l_p of an edge–edge pair: max(|Δa0|, |Δa1|) + max(|Δb0|, |Δb1|).
+double edge_edge_speed_bound(const PairPositions& displacement) {
+  return std::max(displacement[0].norm(), displacement[1].norm()) +
+         std::max(displacement[2].norm(), displacement[3].norm());
+}
+
+double point_triangle_gap_distance(const PairPositions& x) {
+  return std::sqrt(point_triangle_distance(x[0], x[1], x[2], x[3]));
+}
+
+double edge_edge_gap_distance(const PairPositions& x) {
+  return std::sqrt(edge_edge_distance(x[0], x[1], x[2], x[3]));
+}
+
 }  // namespace
+
+double ccd_first_advance(const PairPositions& start, const PairPositions& end, bool edge_edge,
+                         const AdditiveCcdSettings& settings) {
+  const PairPositions displacement = relative_displacements(start, end);
+  const double speed_bound = edge_edge ? edge_edge_speed_bound(displacement)
+                                       : point_triangle_speed_bound(displacement);
+  const double gap = (edge_edge ? edge_edge_gap_distance(start) : point_triangle_gap_distance(start)) -
+                     settings.min_distance - rounding_margin(start, end);
+  if (!(gap > 0)) return 0.0;
+  if (speed_bound == 0) return std::numeric_limits<double>::infinity();
+  return std::min(settings.rescaling, 1 - settings.ratio_bound) * gap / speed_bound;
+}
 
 void validate_ccd_settings(const AdditiveCcdSettings& settings) {
   auto require = [](bool ok, const char* name, double value, const char* range) {
@@ -103,22 +136,15 @@ void validate_ccd_settings(const AdditiveCcdSettings& settings) {
 CcdResult point_triangle_ccd(const PairPositions& start, const PairPositions& end,
                              const AdditiveCcdSettings& settings) {
   const PairPositions displacement = relative_displacements(start, end);
-  const double speed_bound =
-      displacement[0].norm() +
-      std::max({displacement[1].norm(), displacement[2].norm(), displacement[3].norm()});
-  return advance(
-      start, displacement, speed_bound, settings, rounding_margin(start, end),
-      [](const PairPositions& x) { return std::sqrt(point_triangle_distance(x[0], x[1], x[2], x[3])); });
+  return advance(start, displacement, point_triangle_speed_bound(displacement), settings,
+                 rounding_margin(start, end), point_triangle_gap_distance);
 }
 
 CcdResult edge_edge_ccd(const PairPositions& start, const PairPositions& end,
                         const AdditiveCcdSettings& settings) {
   const PairPositions displacement = relative_displacements(start, end);
-  const double speed_bound = std::max(displacement[0].norm(), displacement[1].norm()) +
-                             std::max(displacement[2].norm(), displacement[3].norm());
-  return advance(
-      start, displacement, speed_bound, settings, rounding_margin(start, end),
-      [](const PairPositions& x) { return std::sqrt(edge_edge_distance(x[0], x[1], x[2], x[3])); });
+  return advance(start, displacement, edge_edge_speed_bound(displacement), settings,
+                 rounding_margin(start, end), edge_edge_gap_distance);
 }
 
 }  // namespace psq

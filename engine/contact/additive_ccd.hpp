@@ -26,6 +26,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 
 namespace psq {
 
@@ -55,6 +56,11 @@ struct AdditiveCcdSettings {
   int max_iterations = 10'000;
   /// The query covers t ∈ [0, t_max] (t_max > 0); t_max = 1 is the full step.
   double t_max = 1.0;
+  /// Once the advance has passed this time the query ends, reporting no collision at the time
+  /// reached: a caller that already holds this bound from another pair learns nothing more.
+  /// Unlike a smaller t_max it leaves the advances before it as they are, so a collision found
+  /// earlier is found at the same time.
+  double stop_after = std::numeric_limits<double>::infinity();
 };
 
 /// Throws InputError naming the first setting outside its range (see AdditiveCcdSettings).
@@ -72,6 +78,13 @@ struct CcdResult {
   /// Distance evaluations after the initial one.
   int iterations = 0;
 };
+
+/// The time s′ (d₀ − ξ − δ)/l_p that a pair's first advance covers: over [0, t] with t up to
+/// it the pair provably stays apart, and its query cannot report a collision before it. 0 when the pair starts
+/// within ξ + δ, +∞ when it does not move relative to itself. Lets a caller after the smallest
+/// time of impact over many pairs skip those that cannot lower the one it already has.
+double ccd_first_advance(const PairPositions& start, const PairPositions& end, bool edge_edge,
+                         const AdditiveCcdSettings& settings = {});
 
 /// ACCD for a point p and a triangle (t0, t1, t2): positions (p, t0, t1, t2) at t = 0 and 1.
 /// l_p = |Δp| + max_i |Δt_i| after the mean displacement is removed. NumericalError if a

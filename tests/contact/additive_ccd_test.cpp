@@ -241,6 +241,74 @@ TEST(AdditiveCcd, StopsAtTmax) {
   EXPECT_EQ(result.toi, 0.4);
 }
 
+/// A random pair and a random straight motion of it, fast enough that many pairs collide.
+std::pair<PairPositions, PairPositions> random_motion(std::mt19937& rng) {
+  PairPositions start, end;
+  for (int i = 0; i < 4; ++i) {
+    start[i] = test::random_point(rng);
+    end[i] = start[i] + 2.0 * test::random_point(rng);
+  }
+  return {start, end};
+}
+
+TEST(AdditiveCcd, StoppingAfterABoundKeepsEveryEarlierTimeOfImpact) {
+  // Random pairs, many of them close and fast: with stop_after = τ a query that would have
+  // reported a time of impact below τ reports the same one, and any other ends at or after τ
+  // without a collision.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> bound(0.01, 1.0);
+  int earlier = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const auto [start, end] = random_motion(rng);
+    const bool edge_edge = trial % 2 == 1;
+    const auto query = [&](const AdditiveCcdSettings& settings) {
+      return edge_edge ? edge_edge_ccd(start, end, settings) : point_triangle_ccd(start, end, settings);
+    };
+    const CcdResult full = query({});
+    AdditiveCcdSettings stopping;
+    stopping.stop_after = bound(rng);
+    const CcdResult stopped = query(stopping);
+    if (full.toi < stopping.stop_after) {
+      ++earlier;
+      EXPECT_EQ(stopped.collision, full.collision) << trial;
+      EXPECT_EQ(stopped.toi, full.toi) << trial;
+    } else {
+      EXPECT_FALSE(stopped.collision) << trial;
+      EXPECT_GE(stopped.toi, stopping.stop_after) << trial;
+      EXPECT_LE(stopped.iterations, full.iterations) << trial;
+    }
+  }
+  EXPECT_GT(earlier, 100);  // both branches were exercised
+}
+
+TEST(AdditiveCcd, NoCollisionIsReportedWithinTheFirstAdvance) {
+  // ccd_first_advance is a lower bound of every query's time of impact, and a query whose step
+  // ends there finds the pair apart.
+  std::mt19937 rng(11);
+  int limiting = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const auto [start, end] = random_motion(rng);
+    const bool edge_edge = trial % 2 == 1;
+    const double first = ccd_first_advance(start, end, edge_edge);
+    AdditiveCcdSettings settings;
+    const CcdResult full =
+        edge_edge ? edge_edge_ccd(start, end, settings) : point_triangle_ccd(start, end, settings);
+    EXPECT_GE(full.toi, std::min(first, 1.0)) << trial;
+    if (first >= 1.0) continue;
+    ++limiting;
+    settings.t_max = first;
+    const CcdResult within =
+        edge_edge ? edge_edge_ccd(start, end, settings) : point_triangle_ccd(start, end, settings);
+    EXPECT_FALSE(within.collision) << trial;
+    EXPECT_EQ(within.iterations, 1) << trial;
+  }
+  EXPECT_GT(limiting, 100);
+  // Touching: nothing is covered.
+  const PairPositions touching{Vector3d(0, 0, 0), Vector3d(0, 0, 0), Vector3d(1, 0, 0),
+                               Vector3d(0, 1, 0)};
+  EXPECT_EQ(ccd_first_advance(touching, touching, false), 0.0);
+}
+
 TEST(AdditiveCcd, IterationCapReportsACollisionAtTheTimeReached) {
   // A fast slide 1 above the triangle's plane needs many small advances.
   const PointMotion motion({0.25, 0.25, 1}, {100, 0.25, 1});
