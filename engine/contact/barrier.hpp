@@ -72,8 +72,8 @@ BarrierStiffness initial_barrier_stiffness(double bbox_diagonal, const BarrierBa
 /// where the CCD creeps. IPC doubles κ when the smallest gap g = √d − ξ over all pairs was
 /// already below ε_g = gap_scale · l (l the bounding-box diagonal) and has decreased again.
 /// Doubling is too slow where a stiff structure presses a contact far below ε_g and holds it
-/// there: a crushed aluminium can squeezed a gap to 1e-10 m, and the CCD then cut every
-/// Newton step to 5e-4 of its length for hundreds of iterations. So when the caller reports
+/// there (a crushed can's rim against the plate): the CCD then cuts every Newton step to a
+/// sliver of its length until κ has caught up. So when the caller reports
 /// that the CCD cut the steps (`steps_cut_by_ccd`) and the gap has stalled below ε_g (it
 /// changed by less than a factor 2 since the last update), κ grows by the ratio of the
 /// barrier's push at g to its push at ε_g, the κ that would hold the same force at ε_g:
