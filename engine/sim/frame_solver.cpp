@@ -80,7 +80,8 @@ NewtonSolver::Progress numbered_through_frame(NewtonSolver::Progress progress, i
 FrameSolver::FrameSolver(const ShellSystem& system, IncrementalPotential& potential)
     : system_(system),
       potential_(potential),
-      dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()) {
+      dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()),
+      pull_weight_floor_(stiffest_membrane(system.scene())) {
   const Scene& scene = system.scene();
   if (contact_enabled(scene)) {
     contact_ = std::make_unique<ContactTerm>(system_);
@@ -121,7 +122,6 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
   system_.apply_pins(target, record.time);
   std::vector<int> pulled, held;
   std::vector<double> weights;
-  const double structural_weight = stiffest_membrane(system_.scene());
   for (const PinnedVertex& p : system_.pinned()) {
     if (target.segment<3>(3 * p.vertex) == x.segment<3>(3 * p.vertex)) {
       held.push_back(p.vertex);
@@ -129,7 +129,7 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
     }
     pulled.push_back(p.vertex);
     const double mass = std::max(system_.dof_masses()[3 * p.vertex], contact_->average_mass());
-    weights.push_back(std::max(potential_.inertia_weight() * mass, structural_weight));
+    weights.push_back(std::max(potential_.inertia_weight() * mass, pull_weight_floor_));
   }
   pull_.set(std::move(pulled), target, std::move(weights));
   potential_.add_term(pull_);

@@ -128,6 +128,8 @@ class FrameSolver {
   std::unique_ptr<StrainLimitTerm> strain_limit_;  ///< null when no shell sets a strain limit
   KinematicPull pull_;
   DofMap dofs_;
+  /// The least weight of a pulled vertex: the stiffest shell's membrane stiffness (N/m).
+  double pull_weight_floor_;
   NewtonSolver newton_;
 };
 
