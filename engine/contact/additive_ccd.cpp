@@ -70,7 +70,12 @@ CcdResult advance(const PairPositions& start, const PairPositions& displacement,
   const double gap_bound = settings.ratio_bound * initial_gap;
   double t = 0, gap = initial_gap;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
-    const double next_t = std::min(t + step_fraction * gap / speed_bound, settings.t_max);
+    // Either advance keeps the gap above the bound while it closes at most at l_p; the second
+    // is the longer once the pair has separated beyond its bound, which with r near 1 makes
+    // the difference between a few advances and thousands for a pair moving apart.
+    const double advance_length =
+        std::max(step_fraction * gap, settings.rescaling * (gap - gap_bound));
+    const double next_t = std::min(t + advance_length / speed_bound, settings.t_max);
     const double next_gap = distance_at(next_t) - contact;
     // The first advance keeps the gap above (1 − s′)(d₀ − ξ) ≥ r (d₀ − ξ) by construction;
     // testing it against the ratio bound would only let rounding reject a head-on approach.

@@ -214,6 +214,23 @@ TEST(AdditiveCcd, LargeRatioBoundKeepsMostOfTheGap) {
   EXPECT_GE(motion.distance_at(result.toi), 0.5 * (1 - 1e-9));
 }
 
+// With r = 0.999 each advance may close only 0.1 % of the gap; a pair moving apart still
+// passes the full step in a few advances, since the gap's excess over r·d₀ bounds the step.
+TEST(AdditiveCcd, ASeparatingPairPassesQuicklyEvenWithARatioBoundNearOne) {
+  const PointMotion motion({0.25, 0.25, 1e-6}, {0.25, 0.25, 1.0});
+  AdditiveCcdSettings settings;
+  settings.ratio_bound = 0.999;
+  const CcdResult result = point_triangle_ccd(motion.start, motion.end, settings);
+  EXPECT_FALSE(result.collision);
+  EXPECT_EQ(result.toi, 1.0);
+  EXPECT_LE(result.iterations, 40);
+  // Head-on, the same bound still keeps 99.9 % of the gap.
+  const PointMotion falling({0.25, 0.25, 1}, {0.25, 0.25, -1});
+  const CcdResult stopped = point_triangle_ccd(falling.start, falling.end, settings);
+  EXPECT_TRUE(stopped.collision);
+  EXPECT_GE(falling.distance_at(stopped.toi), 0.999 * (1 - 1e-9));
+}
+
 TEST(AdditiveCcd, MinimumDistanceCountsAsContact) {
   // With ξ = 0.5 the falling point reaches the contact distance at t = 0.25.
   const PointMotion motion({0.25, 0.25, 1}, {0.25, 0.25, -1});
