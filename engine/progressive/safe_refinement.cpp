@@ -30,14 +30,18 @@ constexpr double kPerturbationDivisor = 10.0;
 /// d̂ in tight contact, and a perturbation below about 1e-13 of the coordinates is lost to
 /// rounding.
 constexpr double kPerturbationFloor = 1e-7;
-/// Layouts tried per cluster (the target layout, the fitted rest layout, then random rotations
-/// of it) before the cluster is expanded one vertex at a time instead.
-constexpr int kClusterLayoutTries = 8;
+/// Layouts tried per cluster (the anchors, then shrunk: the anchors, the targets, the fitted rest
+/// layout and random rotations of it) before the cluster is expanded one vertex at a time.
+constexpr int kClusterLayoutTries = 9;
 /// Random directions tried per vertex when a cluster is expanded one vertex at a time.
 constexpr int kVertexDirectionTries = 64;
 /// ACCD ratio bounds (§4.4.2): pairs closer than g keep 99.9 % of their gap, others 10 %.
 constexpr double kCloseRatioBound = 0.999;
 constexpr double kFarRatioBound = 0.1;
+/// ACCD iterations per pair and round of an advance. A capped query stops its pair where it got
+/// (safe, only shorter): with r = 0.999 a closing pair may take thousands of iterations to its
+/// bound, and the advance needs no more than a safe fraction.
+constexpr int kAdvanceCcdIterations = 200;
 /// Additive CCD rounds per advance; each round stops at least one pair's vertices, so the cap
 /// only ends advances whose limiting pairs keep changing.
 constexpr int kMaxAdvanceRounds = 200;
@@ -179,6 +183,47 @@ bool vertex_patch_clean(const MixedMesh& mesh, const Positions& y, int vertex,
   return true;
 }
 
+/// The four vertices of candidate i: point–triangle candidates first, (p, t0, t1, t2), then
+/// edge–edge, (a0, a1, b0, b1).
+std::array<int, 4> candidate_vertices(const BroadPhase& broad, const ContactCandidates& candidates,
+                                      std::size_t i) {
+  const std::size_t pt = candidates.point_triangle.size();
+  if (i < pt) {
+    const auto& c = candidates.point_triangle[i];
+    return {c.vertex, broad.triangles()(c.triangle, 0), broad.triangles()(c.triangle, 1),
+            broad.triangles()(c.triangle, 2)};
+  }
+  const auto& c = candidates.edge_edge[i - pt];
+  return {broad.edges()[c.edge0][0], broad.edges()[c.edge0][1], broad.edges()[c.edge1][0],
+          broad.edges()[c.edge1][1]};
+}
+
+/// The distance of candidate i at positions p.
+double candidate_distance(const ContactCandidates& candidates, std::size_t i,
+                          const PairPositions& x) {
+  return std::sqrt(i < candidates.point_triangle.size()
+                       ? point_triangle_distance(x[0], x[1], x[2], x[3])
+                       : edge_edge_distance(x[0], x[1], x[2], x[3]));
+}
+
+/// The fine vertices of the mixed mesh's pairs (of bodies that may touch) closer than `reach`
+/// at fine positions y.
+std::vector<int> close_vertices(const MixedMesh& mesh, const BodyPairRule& may_touch,
+                                const Positions& y, double reach) {
+  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+  const Positions p = mesh.positions(y);
+  const ContactCandidates candidates = broad.distance_candidates(p, reach);
+  std::vector<int> vertices;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const std::array<int, 4> v = candidate_vertices(broad, candidates, i);
+    PairPositions x;
+    for (int k = 0; k < 4; ++k) x[k] = row(p, v[k]);
+    if (candidate_distance(candidates, i, x) < reach)
+      for (int k : v) vertices.push_back(mesh.fine_vertex[k]);
+  }
+  return vertices;
+}
+
 /// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
 /// displacements `delta` (rows per fine vertex; zero rows stay): rounds of ACCD over the swept
 /// candidates, each moving all by the smallest safe fraction and then stopping the vertices of
@@ -191,23 +236,16 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
   int rounds = 0;
   for (; rounds < kMaxAdvanceRounds && !d.isZero(0.0); ++rounds) {
     const Positions end = p + d;
-    const ContactCandidates candidates = broad.swept_candidates(p, end, ccd.min_distance);
+    // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion.
+    const ContactCandidates candidates = broad.swept_candidates(p, end, ccd.min_distance + gap);
     const auto moving = [&](std::initializer_list<int> vertices) {
       for (int v : vertices)
         if (!d.row(v).isZero(0.0)) return true;
       return false;
     };
     const std::size_t pt = candidates.point_triangle.size();
-    // Point–triangle candidates first, then edge–edge: (p, t0, t1, t2) or (a0, a1, b0, b1).
-    const auto pair_vertices = [&](std::size_t i) -> std::array<int, 4> {
-      if (i < pt) {
-        const auto& c = candidates.point_triangle[i];
-        return {c.vertex, broad.triangles()(c.triangle, 0), broad.triangles()(c.triangle, 1),
-                broad.triangles()(c.triangle, 2)};
-      }
-      const auto& c = candidates.edge_edge[i - pt];
-      return {broad.edges()[c.edge0][0], broad.edges()[c.edge0][1], broad.edges()[c.edge1][0],
-              broad.edges()[c.edge1][1]};
+    const auto pair_vertices = [&](std::size_t i) {
+      return candidate_vertices(broad, candidates, i);
     };
     std::vector<double> toi(candidates.size(), 1.0);
     tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
@@ -219,9 +257,7 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
         start[k] = row(p, v[k]);
         stop[k] = row(end, v[k]);
       }
-      const double d0 =
-          std::sqrt(point_triangle ? point_triangle_distance(start[0], start[1], start[2], start[3])
-                                   : edge_edge_distance(start[0], start[1], start[2], start[3]));
+      const double d0 = candidate_distance(candidates, i, start);
       AdditiveCcdSettings settings = ccd;
       settings.ratio_bound = d0 - ccd.min_distance < gap ? kCloseRatioBound : kFarRatioBound;
       const CcdResult result = point_triangle ? point_triangle_ccd(start, stop, settings)
@@ -286,6 +322,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   const ContactParameters parameters = contact_parameters(fine);
   AdditiveCcdSettings ccd = parameters.ccd;
   ccd.min_distance = parameters.band.thickness;
+  ccd.max_iterations = kAdvanceCcdIterations;
   const double cap = parameters.band.thickness + parameters.band.activation_distance;
   const double perturbation_floor =
       kPerturbationFloor * bounding_box_diagonal(fine.rest_mesh().vertices);
@@ -329,12 +366,18 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       expand(k);
   }
 
-  // The children of k at parent + s·R·(layout offset), the farthest at `radius`: the layout is
-  // the anchors or the targets about the parent, or the children's rest positions about their
-  // centroid.
+  // The children of k in `out` at parent + s·R·(layout offset), the farthest at `radius` (at
+  // most the layout's own size, s ≤ 1): the layout is the anchors or the targets about the
+  // parent, or the children's rest positions about their centroid.
   enum class Layout { anchors, targets, rest };
+  struct ClusterLayout {
+    Eigen::Matrix3d rotation;
+    Layout layout;
+  };
+  std::map<int, ClusterLayout> layouts;  // the last layout each cluster was placed by
   const Positions& fine_rest = fine.rest_mesh().vertices;
-  const auto place = [&](int k, const Eigen::Matrix3d& rotation, double radius, Layout layout) {
+  const auto place_into = [&](Positions& out, int k, const Eigen::Matrix3d& rotation,
+                              double radius, Layout layout) {
     const Eigen::Vector3d centre = row(coarse, k);
     Eigen::Vector3d origin = centre;
     if (layout == Layout::rest) {
@@ -352,8 +395,12 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     };
     double farthest = 0.0;
     for (int v : children[k]) farthest = std::max(farthest, offset(v).norm());
-    const double scale = farthest > 0.0 ? radius / farthest : 0.0;
-    for (int v : children[k]) y.row(v) = (centre + scale * (rotation * offset(v))).transpose();
+    const double scale = farthest > 0.0 ? std::min(1.0, radius / farthest) : 0.0;
+    for (int v : children[k]) out.row(v) = (centre + scale * (rotation * offset(v))).transpose();
+  };
+  const auto place = [&](int k, const Eigen::Matrix3d& rotation, double radius, Layout layout) {
+    place_into(y, k, rotation, radius, layout);
+    layouts[k] = {rotation, layout};
   };
   // The rotation that best maps the children's rest layout onto their target layout (Kabsch).
   const auto fitted_rotation = [&](int k) {
@@ -374,9 +421,15 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     return Eigen::Matrix3d(svd.matrixU() * flip * svd.matrixV().transpose());
   };
 
+  // The refinement's safe gap g (§4.4.2) is measured once, on x_l: the ratio bounds keep pairs
+  // closer than g where they are. Measured again before each batch it would shrink with every
+  // batch's advance (pairs at g may end at g/10), and the gaps with it, geometrically.
+  Clock::time_point phase = Clock::now();
+  const double safe_gap = mixed_gap(MixedMesh(surface, representative), surface.may_touch, y, cap);
+  stats.gap_seconds += since(phase);
   stats.smallest_gap = std::numeric_limits<double>::infinity();
   for (const auto& [batch_color, clusters] : batches) {
-    Clock::time_point phase = Clock::now();
+    phase = Clock::now();
     const double gap = mixed_gap(MixedMesh(surface, representative), surface.may_touch, y, cap);
     stats.gap_seconds += since(phase);
     if (!(gap > ccd.min_distance))
@@ -393,25 +446,38 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     // bound, then keep it intersection-free.
     const double radius =
         std::max((gap - ccd.min_distance) / kPerturbationDivisor, perturbation_floor);
+    // Each cluster is first placed at its anchors themselves: its piece of the deformed level-l
+    // surface, resampled. Where the exact check passes, no perturbation is needed, and the
+    // patch's pairs start as far apart as the surface's own elements.
     for (int k : clusters) {
       expand(k);
-      place(k, Eigen::Matrix3d::Identity(), radius, Layout::anchors);
+      place(k, Eigen::Matrix3d::Identity(), std::numeric_limits<double>::infinity(),
+            Layout::anchors);
     }
     std::set<int> failing;
     const MixedMesh expanded(surface, representative);  // the layouts move vertices only
     for (int tries = 0;; ++tries) {
       failing.clear();
-      for (int v : intersecting_vertices(expanded, y, surface.may_touch))
+      std::vector<int> bad = intersecting_vertices(expanded, y, surface.may_touch);
+      // The anchors may lie on the level-l edges that the neighbouring, not yet expanded
+      // clusters' triangles share, or next to another layer: they must keep pairs at least as
+      // far apart as a perturbation would.
+      if (tries == 0) {
+        const std::vector<int> close = close_vertices(expanded, surface.may_touch, y, radius);
+        bad.insert(bad.end(), close.begin(), close.end());
+      }
+      for (int v : bad)
         if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
           failing.insert(parent[v]);
       if (failing.empty() || tries == kClusterLayoutTries) break;
       for (int k : failing) {
         ++stats.perturbation_retries;
-        if (tries == 0) {
-          place(k, Eigen::Matrix3d::Identity(), radius, Layout::targets);
+        if (tries == 0 || tries == 1) {
+          place(k, Eigen::Matrix3d::Identity(), radius,
+                tries == 0 ? Layout::anchors : Layout::targets);
           continue;
         }
-        if (tries == 1) {
+        if (tries == 2) {
           place(k, fitted_rotation(k), radius, Layout::rest);
           continue;
         }
@@ -502,21 +568,33 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     stats.perturb_seconds += since(phase);
 
     phase = Clock::now();
+    // The perturbed layouts first grow to their full size about their parents: a patch scaled
+    // about its centre keeps its shape, so its own pairs only separate while only pairs with the
+    // rest of the surface can limit the growth. Straight to the targets, the patch's pairs start
+    // at a hundredth of the perturbation and any of them that closes in would stop its vertices
+    // there, its gap then shrinking the next batch's perturbation (measured from it) in turn.
+    Positions growth = Positions::Zero(n, 3);
+    for (int k : clusters) {
+      if (failing.contains(k)) continue;
+      Positions full = y;
+      place_into(full, k, layouts[k].rotation, std::numeric_limits<double>::infinity(),
+                 layouts[k].layout);
+      for (int v : children[k]) growth.row(v) = full.row(v) - y.row(v);
+    }
+    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(growth));
     Positions delta = Positions::Zero(n, 3);
     for (int k : clusters)
       for (int v : children[k]) delta.row(v) = goal.row(v) - y.row(v);
-    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, gap, y, std::move(delta));
+    const int rr = advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(delta));
+    stats.ccd_rounds += rr;
     stats.ccd_seconds += since(phase);
   }
 
   // Every vertex the rest of the way, as far as it safely goes.
-  Clock::time_point phase = Clock::now();
   const MixedMesh full(surface, representative);
-  const double gap = mixed_gap(full, surface.may_touch, y, cap);
-  if (!std::isfinite(stats.smallest_gap)) stats.smallest_gap = gap;
-  stats.gap_seconds += since(phase);
+  if (!std::isfinite(stats.smallest_gap)) stats.smallest_gap = safe_gap;
   phase = Clock::now();
-  stats.ccd_rounds += advance(full, surface.may_touch, ccd, gap, y, goal - y);
+  stats.ccd_rounds += advance(full, surface.may_touch, ccd, safe_gap, y, goal - y);
   stats.ccd_seconds += since(phase);
 
   phase = Clock::now();

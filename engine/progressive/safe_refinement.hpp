@@ -6,24 +6,30 @@
 // Each level-(l+1) vertex starts at its parent's position: every coarse vertex is a cluster of
 // coincident children, and the surface is x_l itself ("mixed" meshes below: the level-(l+1)
 // triangles with the not yet expanded clusters merged into one vertex, whose images are the
-// level-l triangles). Per colour:
-//   1. g, the smallest distance between primitives of the current mixed mesh that may touch;
-//   2. every cluster of the colour is perturbed: its children move from the parent's position
-//      toward their anchors (their intrinsic places on the deformed level-l surface, which
-//      lie in the sectors of the parent's one-ring their triangles take) by a common factor,
-//      the farthest by g/10. Every point of
-//      the new triangles is then within g/10 of the old surface, so only the expansion patch
-//      itself can intersect; the exact check decides. A cluster whose patch intersects is tried
-//      again toward its prolonged targets, then with the children's rest layout turned by the
-//      rotation that best fits it to the targets, then by random rotations; a cluster no layout
-//      suits is expanded by undoing its collapses latest first (single edge expansions,
-//      §4.4.1): each removed vertex splits off its survivor toward its anchor's offset, then
-//      into the sector of its neighbours, then in random directions, its triangles checked
-//      exactly (bounded tries, seeded so that a resumed run repeats them);
-//   3. the colour's vertices advance toward their targets by additive CCD (ACCD with the
-//      per-pair ratio bound: 0.999 for a pair already closer than g, 0.1 otherwise). The
-//      advance is repeated: each round moves every vertex by the smallest safe fraction, then
-//      stops the vertices of the pairs that limited it, and the others go on (§4.4.4).
+// level-l triangles). The safe gap g is measured once, on x_l: the smallest distance between
+// primitives that may touch (capped at the barrier's reach). Per colour:
+//   1. the gap of the current mixed mesh, which bounds how far a perturbation may move;
+//   2. every cluster of the colour is placed at its anchors (its children's intrinsic places on
+//      the deformed level-l surface, in the sectors of the parent's one-ring their triangles
+//      take), which resample the level-l surface itself; the exact check decides, and a cluster
+//      whose patch intersects or comes closer than a perturbation to anything is placed instead
+//      with its anchor layout shrunk about the parent, its farthest child at a tenth of the
+//      current gap. Every point of the new triangles is then within that distance of the old
+//      surface, so only the expansion patch itself can intersect; the exact check decides. A
+//      cluster whose patch intersects is tried again toward its prolonged targets, then with
+//      the children's rest layout turned by the rotation that best fits it to the targets, then
+//      by random rotations; a cluster no layout suits is expanded by undoing its collapses
+//      latest first (single edge expansions, §4.4.1): each removed vertex splits off its
+//      survivor toward its anchor's offset, then into the sector of its neighbours, then in
+//      random directions, its triangles checked exactly (bounded tries, seeded so that a
+//      resumed run repeats them);
+//   3. shrunk layouts grow back to full size about their parents by additive CCD (a scaled patch
+//      keeps its shape, so its own pairs only separate), then the colour's vertices advance
+//      toward their targets by additive CCD (ACCD with the per-pair ratio bound: 0.999 for a
+//      pair already closer than g, 0.1 otherwise, over the pairs whose swept boxes come within
+//      g). The advance is repeated: each round moves every vertex by the smallest safe
+//      fraction, then stops the vertices of the pairs that limited it, and the others go on
+//      (§4.4.4).
 // After the last colour every vertex advances toward its target the same way. The result is
 // checked once more with exact predicates; every step of the way is intersection-free by
 // construction, the final check is the independent judge.
