@@ -15,19 +15,29 @@
 
 namespace {
 
-/// Refuses a first argument that is neither an option nor a command, naming the nearest command:
-/// CLI11 would otherwise take `psq promte --help` for the top-level --help and exit 0.
-void require_known_command(int argc, char** argv, CLI::App& app) {
-  if (argc < 2 || argv[1][0] == '-') return;
-  std::vector<std::string> names;
-  for (const CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
-    names.push_back(command->get_name());
-  const std::string given = argv[1];
-  if (std::find(names.begin(), names.end(), given) != names.end()) return;
-  const auto nearest = psq::suggest_key(given, names);
-  throw psq::InputError(fmt::format("unknown command '{}'{}; `psq --help` lists the commands",
-                                    given,
-                                    nearest ? fmt::format(" (did you mean '{}'?)", *nearest) : ""));
+/// Refuses a word where a command is expected (the first argument, and after a command that has
+/// commands of its own) that is none of them, naming the nearest: CLI11 would otherwise take
+/// `psq promte --help` for the top-level --help and exit 0, and `psq sweep ad` for a missing
+/// command.
+void require_known_commands(int argc, char** argv, CLI::App& app) {
+  CLI::App* parent = &app;
+  std::string path = "psq";
+  for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+    const std::vector<CLI::App*> commands = parent->get_subcommands([](CLI::App*) { return true; });
+    if (commands.empty()) return;
+    std::vector<std::string> names;
+    for (const CLI::App* command : commands) names.push_back(command->get_name());
+    const std::string given = argv[i];
+    const auto found = std::find(names.begin(), names.end(), given);
+    if (found == names.end()) {
+      const auto nearest = psq::suggest_key(given, names);
+      throw psq::InputError(fmt::format(
+          "unknown command '{}'{}; `{} --help` lists the commands", given,
+          nearest ? fmt::format(" (did you mean '{}'?)", *nearest) : "", path));
+    }
+    parent = commands[static_cast<std::size_t>(found - names.begin())];
+    path += " " + given;
+  }
 }
 
 }  // namespace
@@ -51,13 +61,14 @@ int main(int argc, char** argv) {
   psq::runner::register_hierarchy_command(app, commands);
   psq::runner::register_slurm_command(app, commands);
   try {
-    require_known_command(argc, argv, app);
+    require_known_commands(argc, argv, app);
     app.parse(argc, argv);
     for (const auto& command : commands)
       if (command.app->parsed()) return command.run();
     return psq::runner::kExitInternalError;
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // CLI11 prints the message (or the help, exit 0); bad arguments are bad input.
+    return app.exit(e) == 0 ? 0 : psq::runner::kExitInputError;
   } catch (const psq::InputError& e) {
     std::cerr << "psq: error: " << e.what() << '\n';
     return psq::runner::kExitInputError;

@@ -21,6 +21,21 @@ TEST(CommandLine, ATypoOfACommandSuggestsIt) {
   EXPECT_NE(result.errors.find("did you mean 'report'?"), std::string::npos) << result.errors;
 }
 
+TEST(CommandLine, AnUnknownCommandOfACommandSuggestsTheNearestOfItsCommands) {
+  const auto result = test::run_psq({"sweep", "ad", "x.toml"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.errors.find("unknown command 'ad' (did you mean 'add'?); `psq sweep --help`"),
+            std::string::npos)
+      << result.errors;
+}
+
+TEST(CommandLine, BadArgumentsAreInputErrors) {
+  const auto missing = test::run_psq({"sweep"});  // its command missing
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.errors.find("subcommand is required"), std::string::npos) << missing.errors;
+  EXPECT_EQ(test::run_psq({"sim", "--levels", "two", "x.toml"}).exit_code, 1);
+}
+
 TEST(CommandLine, KnownCommandsAndTopLevelOptionsStillWork) {
   EXPECT_EQ(test::run_psq({"--help"}).exit_code, 0);
   const auto help = test::run_psq({"sim", "--help"});
