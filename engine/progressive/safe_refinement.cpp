@@ -33,6 +33,9 @@ constexpr double kPerturbationFloor = 1e-7;
 /// Layouts tried per cluster (the anchors, then shrunk: the anchors, the targets, the fitted rest
 /// layout and random rotations of it) before the cluster is expanded one vertex at a time.
 constexpr int kClusterLayoutTries = 9;
+/// The smallest distance between elements of a shrunk layout, relative to its size: the rest
+/// layout, a piece of a good mesh, keeps about its edge ratio.
+constexpr double kSmallestShrunkGap = 1e-2;
 /// Random directions tried per vertex when a cluster is expanded one vertex at a time.
 constexpr int kVertexDirectionTries = 64;
 /// ACCD ratio bounds (§4.4.2): pairs closer than g keep 99.9 % of their gap, others 10 %.
@@ -461,11 +464,12 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       std::vector<int> bad = intersecting_vertices(expanded, y, surface.may_touch);
       // The anchors may lie on the level-l edges that the neighbouring, not yet expanded
       // clusters' triangles share, or next to another layer: they must keep pairs at least as
-      // far apart as a perturbation would.
-      if (tries == 0) {
-        const std::vector<int> close = close_vertices(expanded, surface.may_touch, y, radius);
-        bad.insert(bad.end(), close.begin(), close.end());
-      }
+      // far apart as a perturbation would. A shrunk layout must not bring its own elements
+      // much closer than its size (anchors of two children can nearly coincide on a folded
+      // surface): such a gap would bound the next batch's perturbation and the solve's barrier.
+      const std::vector<int> close = close_vertices(
+          expanded, surface.may_touch, y, tries == 0 ? radius : kSmallestShrunkGap * radius);
+      bad.insert(bad.end(), close.begin(), close.end());
       for (int v : bad)
         if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
           failing.insert(parent[v]);
