@@ -31,18 +31,6 @@ constexpr double kMaxCertificateRadius = 16.0;
 
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
 
-/// The four stencil positions of a pair.
-PairPositions stencil_positions(const std::array<int, 4>& vertices, const Eigen::VectorXd& x) {
-  return {vertex_of(x, vertices[0]), vertex_of(x, vertices[1]), vertex_of(x, vertices[2]),
-          vertex_of(x, vertices[3])};
-}
-
-double pair_distance(const ContactPair& pair, const Eigen::VectorXd& x) {
-  const PairPositions p = stencil_positions(pair.vertices, x);
-  return pair.edge_edge ? edge_edge_distance(p[0], p[1], p[2], p[3])
-                        : point_triangle_distance(p[0], p[1], p[2], p[3]);
-}
-
 /// m(c) b(d − ξ²) of one pair (m = 1 for point–triangle), +∞ within the thickness.
 double pair_value(const ContactPair& pair, const Eigen::VectorXd& x, const BarrierBand& band) {
   const double s = band.barrier_argument(pair_distance(pair, x));
@@ -122,23 +110,6 @@ double smallest_time_of_impact(const std::vector<ContactPair>& pairs, const Eige
   return step;
 }
 
-/// The candidates as stencils, point–triangle pairs first (mollifier thresholds not set).
-std::vector<ContactPair> pairs_of(const ContactCandidates& candidates,
-                                  const ContactSurface& surface) {
-  std::vector<ContactPair> pairs;
-  pairs.reserve(candidates.size());
-  for (const PointTriangleCandidate& c : candidates.point_triangle) {
-    const auto t = surface.triangles.row(c.triangle);
-    pairs.push_back({{c.vertex, t[0], t[1], t[2]}, false, 0.0});
-  }
-  for (const EdgeEdgeCandidate& c : candidates.edge_edge) {
-    const auto& a = surface.edges[c.edge0];
-    const auto& b = surface.edges[c.edge1];
-    pairs.push_back({{a[0], a[1], b[0], b[1]}, true, 0.0});
-  }
-  return pairs;
-}
-
 void check_parameters(const ContactParameters& parameters) {
   const BarrierBand& band = parameters.band;
   if (!(band.activation_distance > 0) || !std::isfinite(band.activation_distance))
@@ -151,6 +122,34 @@ void check_parameters(const ContactParameters& parameters) {
 }
 
 }  // namespace
+
+PairPositions stencil_positions(const std::array<int, 4>& vertices, const Eigen::VectorXd& x) {
+  return {vertex_of(x, vertices[0]), vertex_of(x, vertices[1]), vertex_of(x, vertices[2]),
+          vertex_of(x, vertices[3])};
+}
+
+double pair_distance(const ContactPair& pair, const Eigen::VectorXd& x) {
+  const PairPositions p = stencil_positions(pair.vertices, x);
+  return pair.edge_edge ? edge_edge_distance(p[0], p[1], p[2], p[3])
+                        : point_triangle_distance(p[0], p[1], p[2], p[3]);
+}
+
+std::vector<ContactPair> candidate_pairs(const ContactCandidates& candidates,
+                                         const BroadPhase& broad) {
+  std::vector<ContactPair> pairs;
+  pairs.reserve(candidates.size());
+  for (const PointTriangleCandidate& c : candidates.point_triangle) {
+    const auto t = broad.triangles().row(c.triangle);
+    pairs.push_back({{c.vertex, t[0], t[1], t[2]}, false, 0.0});
+  }
+  for (const EdgeEdgeCandidate& c : candidates.edge_edge) {
+    const auto& a = broad.edges()[c.edge0];
+    const auto& b = broad.edges()[c.edge1];
+    pairs.push_back({{a[0], a[1], b[0], b[1]}, true, 0.0});
+  }
+  return pairs;
+}
+
 
 double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x) {
   if (!pair.edge_edge) return 1.0;
@@ -233,7 +232,7 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
     candidates = broad_phase_.distance_candidates(as_positions(x), reach());
   }
   ScopedTimer timer(stats_.barrier_seconds);
-  std::vector<ContactPair> pairs = pairs_of(candidates, surface_);
+  std::vector<ContactPair> pairs = candidate_pairs(candidates, broad_phase_);
   std::vector<double> distance(pairs.size());
   tbb::parallel_for(std::size_t{0}, pairs.size(),
                     [&](std::size_t k) { distance[k] = pair_distance(pairs[k], x); });
@@ -354,7 +353,7 @@ double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen
   const ContactCandidates candidates =
       broad_phase_.swept_candidates(start, end, parameters_.band.thickness);
   stats_.ccd_pair_queries += static_cast<long>(candidates.size());
-  return smallest_time_of_impact(pairs_of(candidates, surface_), x, x + dx, parameters_.ccd);
+  return smallest_time_of_impact(candidate_pairs(candidates, broad_phase_), x, x + dx, parameters_.ccd);
 }
 
 }  // namespace psq

@@ -77,6 +77,15 @@ struct ContactPair {
   double mollifier_threshold = 0;  ///< ε_x of an edge–edge pair
 };
 
+/// The four positions of a pair's stencil at x (flat, 3n).
+PairPositions stencil_positions(const std::array<int, 4>& vertices, const Eigen::VectorXd& x);
+/// The squared distance of a pair at x (point_triangle_distance, edge_edge_distance).
+double pair_distance(const ContactPair& pair, const Eigen::VectorXd& x);
+/// The candidates as stencils in `broad`'s numbering, point–triangle pairs first (mollifier
+/// thresholds not set).
+std::vector<ContactPair> candidate_pairs(const ContactCandidates& candidates,
+                                         const BroadPhase& broad);
+
 /// The constant factor of a pair's barrier at x: the edge–edge mollifier m(c(x)) of an edge–edge
 /// pair, 1 for a point–triangle pair (the barrier weight of its normal force, friction.hpp).
 double barrier_weight(const ContactPair& pair, const Eigen::VectorXd& x);

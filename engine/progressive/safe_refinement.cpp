@@ -14,9 +14,8 @@
 
 #include "engine/contact/additive_ccd.hpp"
 #include "engine/contact/broad_phase.hpp"
-#include "engine/contact/edge_edge_distance.hpp"
+#include "engine/contact/contact_potential.hpp"
 #include "engine/contact/intersection_check.hpp"
-#include "engine/contact/point_triangle_distance.hpp"
 #include "engine/core/error.hpp"
 #include "engine/sim/contact_term.hpp"
 
@@ -111,6 +110,10 @@ struct MixedMesh {
     for (const auto& t : kept) triangle_body.push_back(body[t[0]]);
   }
 
+  [[nodiscard]] BroadPhase broad_phase(const BodyPairRule& may_touch) const {
+    return BroadPhase(triangles, edges, body, may_touch);
+  }
+
   [[nodiscard]] Positions positions(const Positions& fine) const {
     Positions p(static_cast<Eigen::Index>(fine_vertex.size()), 3);
     for (std::size_t m = 0; m < fine_vertex.size(); ++m)
@@ -186,44 +189,16 @@ bool vertex_patch_clean(const MixedMesh& mesh, const Positions& y, int vertex,
   return true;
 }
 
-/// The four vertices of candidate i: point–triangle candidates first, (p, t0, t1, t2), then
-/// edge–edge, (a0, a1, b0, b1).
-std::array<int, 4> candidate_vertices(const BroadPhase& broad, const ContactCandidates& candidates,
-                                      std::size_t i) {
-  const std::size_t pt = candidates.point_triangle.size();
-  if (i < pt) {
-    const auto& c = candidates.point_triangle[i];
-    return {c.vertex, broad.triangles()(c.triangle, 0), broad.triangles()(c.triangle, 1),
-            broad.triangles()(c.triangle, 2)};
-  }
-  const auto& c = candidates.edge_edge[i - pt];
-  return {broad.edges()[c.edge0][0], broad.edges()[c.edge0][1], broad.edges()[c.edge1][0],
-          broad.edges()[c.edge1][1]};
-}
-
-/// The distance of candidate i at positions p.
-double candidate_distance(const ContactCandidates& candidates, std::size_t i,
-                          const PairPositions& x) {
-  return std::sqrt(i < candidates.point_triangle.size()
-                       ? point_triangle_distance(x[0], x[1], x[2], x[3])
-                       : edge_edge_distance(x[0], x[1], x[2], x[3]));
-}
-
-/// The fine vertices of the mixed mesh's pairs (of bodies that may touch) closer than `reach`
-/// at fine positions y.
-std::vector<int> close_vertices(const MixedMesh& mesh, const BodyPairRule& may_touch,
-                                const Positions& y, double reach) {
-  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+/// The fine vertices of the pairs (of bodies that may touch) of the mixed mesh, whose broad
+/// phase is `broad`, closer than `reach` at fine positions y.
+std::vector<int> close_vertices(const MixedMesh& mesh, const BroadPhase& broad, const Positions& y,
+                                double reach) {
   const Positions p = mesh.positions(y);
-  const ContactCandidates candidates = broad.distance_candidates(p, reach);
+  const Eigen::VectorXd x = flat(p);
   std::vector<int> vertices;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    const std::array<int, 4> v = candidate_vertices(broad, candidates, i);
-    PairPositions x;
-    for (int k = 0; k < 4; ++k) x[k] = row(p, v[k]);
-    if (candidate_distance(candidates, i, x) < reach)
-      for (int k : v) vertices.push_back(mesh.fine_vertex[k]);
-  }
+  for (const ContactPair& pair : candidate_pairs(broad.distance_candidates(p, reach), broad))
+    if (std::sqrt(pair_distance(pair, x)) < reach)
+      for (int k : pair.vertices) vertices.push_back(mesh.fine_vertex[k]);
   return vertices;
 }
 
@@ -233,7 +208,7 @@ std::vector<int> close_vertices(const MixedMesh& mesh, const BodyPairRule& may_t
 /// the limiting pairs. y is updated; returns the rounds taken.
 int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const AdditiveCcdSettings& ccd,
             double gap, Positions& y, Positions delta) {
-  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+  const BroadPhase broad = mesh.broad_phase(may_touch);
   Positions p = mesh.positions(y);
   Positions d = mesh.positions(delta);
   int rounds = 0;
@@ -241,30 +216,24 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
     const Positions end = p + d;
     // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion.
     const ContactCandidates candidates = broad.swept_candidates(p, end, ccd.min_distance + gap);
-    const auto moving = [&](std::initializer_list<int> vertices) {
+    const std::vector<ContactPair> pairs = candidate_pairs(candidates, broad);
+    const Eigen::VectorXd x0 = flat(p), x1 = flat(end);
+    const auto moving = [&](const std::array<int, 4>& vertices) {
       for (int v : vertices)
         if (!d.row(v).isZero(0.0)) return true;
       return false;
     };
-    const std::size_t pt = candidates.point_triangle.size();
-    const auto pair_vertices = [&](std::size_t i) {
-      return candidate_vertices(broad, candidates, i);
-    };
-    std::vector<double> toi(candidates.size(), 1.0);
-    tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
-      PairPositions start, stop;
-      const bool point_triangle = i < pt;
-      const std::array<int, 4> v = pair_vertices(i);
-      if (!moving({v[0], v[1], v[2], v[3]})) return;
-      for (int k = 0; k < 4; ++k) {
-        start[k] = row(p, v[k]);
-        stop[k] = row(end, v[k]);
-      }
-      const double d0 = candidate_distance(candidates, i, start);
+    std::vector<double> toi(pairs.size(), 1.0);
+    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t i) {
+      const ContactPair& pair = pairs[i];
+      if (!moving(pair.vertices)) return;
+      const PairPositions start = stencil_positions(pair.vertices, x0);
+      const PairPositions stop = stencil_positions(pair.vertices, x1);
+      const double d0 = std::sqrt(pair_distance(pair, x0));
       AdditiveCcdSettings settings = ccd;
       settings.ratio_bound = d0 - ccd.min_distance < gap ? kCloseRatioBound : kFarRatioBound;
-      const CcdResult result = point_triangle ? point_triangle_ccd(start, stop, settings)
-                                              : edge_edge_ccd(start, stop, settings);
+      const CcdResult result = pair.edge_edge ? edge_edge_ccd(start, stop, settings)
+                                              : point_triangle_ccd(start, stop, settings);
       if (result.collision) toi[i] = result.toi;
     });
     double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
@@ -287,7 +256,7 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
     d *= 1.0 - alpha;
     for (std::size_t i = 0; i < toi.size(); ++i) {
       if (toi[i] > alpha) continue;
-      for (int k : pair_vertices(i)) d.row(k).setZero();
+      for (int k : pairs[i].vertices) d.row(k).setZero();
     }
   }
   for (std::size_t m = 0; m < mesh.fine_vertex.size(); ++m)
@@ -299,7 +268,7 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
 /// `cap`.
 double mixed_gap(const MixedMesh& mesh, const BodyPairRule& may_touch, const Positions& y,
                  double cap) {
-  const BroadPhase broad(mesh.triangles, mesh.edges, mesh.body, may_touch);
+  const BroadPhase broad = mesh.broad_phase(may_touch);
   return broad.clearance(mesh.positions(y), 0.0, cap);
 }
 
@@ -459,6 +428,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     }
     std::set<int> failing;
     const MixedMesh expanded(surface, representative);  // the layouts move vertices only
+    const BroadPhase expanded_broad = expanded.broad_phase(surface.may_touch);
     for (int tries = 0;; ++tries) {
       failing.clear();
       std::vector<int> bad = intersecting_vertices(expanded, y, surface.may_touch);
@@ -468,7 +438,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       // much closer than its size (anchors of two children can nearly coincide on a folded
       // surface): such a gap would bound the next batch's perturbation and the solve's barrier.
       const std::vector<int> close = close_vertices(
-          expanded, surface.may_touch, y, tries == 0 ? radius : kSmallestShrunkGap * radius);
+          expanded, expanded_broad, y, tries == 0 ? radius : kSmallestShrunkGap * radius);
       bad.insert(bad.end(), close.begin(), close.end());
       for (int v : bad)
         if (children[parent[v]].size() > 1 && color[parent[v]] == batch_color)
@@ -572,11 +542,11 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     stats.perturb_seconds += since(phase);
 
     phase = Clock::now();
-    // The perturbed layouts first grow to their full size about their parents: a patch scaled
-    // about its centre keeps its shape, so its own pairs only separate while only pairs with the
-    // rest of the surface can limit the growth. Straight to the targets, the patch's pairs start
-    // at a hundredth of the perturbation and any of them that closes in would stop its vertices
-    // there, its gap then shrinking the next batch's perturbation (measured from it) in turn.
+    // Shrunk layouts first grow back to full size about their parents: a patch scaled about
+    // its centre keeps its shape, so its own pairs only separate and only pairs with the rest of
+    // the surface can limit the growth. Moved straight to the targets, any of the patch's close
+    // pairs that closes in would stop its vertices there, and its gap would bound the next
+    // batch's perturbation.
     Positions growth = Positions::Zero(n, 3);
     for (int k : clusters) {
       if (failing.contains(k)) continue;
@@ -589,8 +559,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     Positions delta = Positions::Zero(n, 3);
     for (int k : clusters)
       for (int v : children[k]) delta.row(v) = goal.row(v) - y.row(v);
-    const int rr = advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(delta));
-    stats.ccd_rounds += rr;
+    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(delta));
     stats.ccd_seconds += since(phase);
   }
 

@@ -16,7 +16,8 @@
 //      with its anchor layout shrunk about the parent, its farthest child at a tenth of the
 //      current gap. Every point of the new triangles is then within that distance of the old
 //      surface, so only the expansion patch itself can intersect; the exact check decides. A
-//      cluster whose patch intersects is tried again toward its prolonged targets, then with
+//      cluster whose patch intersects, or whose own pairs come closer than a hundredth of the
+//      layout's size, is tried again toward its prolonged targets, then with
 //      the children's rest layout turned by the rotation that best fits it to the targets, then
 //      by random rotations; a cluster no layout suits is expanded by undoing its collapses
 //      latest first (single edge expansions, §4.4.1): each removed vertex splits off its
