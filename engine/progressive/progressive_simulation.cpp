@@ -64,11 +64,6 @@ void check_settings(const Scene& scene, const ProgressiveSettings& settings) {
   if (s.refine_frame && (*s.refine_frame < 1 || *s.refine_frame > scene.time.frames))
     fail(fmt::format("refine_frame must be a frame in 1..{} (got {})", scene.time.frames,
                      *s.refine_frame));
-  if (strain_limit_enabled(scene) && s.levels > 1)
-    fail(
-        "levels > 1 with a strain limit ('strain_limit' in a shell's material): the refinement "
-        "does not yet make its initializer strictly feasible (paper §4.4.5), so run such scenes "
-        "with levels = 1");
   if (settings.max_settle_steps < 1)
     fail(fmt::format("max_settle_steps must be at least 1 (got {})", settings.max_settle_steps));
 }
@@ -333,7 +328,9 @@ void ProgressiveSimulation::refine() {
   Eigen::VectorXd next = to_next_[level_].apply(x_);
   const Eigen::VectorXd coarse = x_;
   const bool contact = contact_enabled(finest_.scene());
-  const Expansion expansion = contact ? system_expansion(level_) : Expansion{};
+  const bool strain_limited = strain_limit_enabled(finest_.scene());
+  const Expansion expansion =
+      contact || strain_limited ? system_expansion(level_) : Expansion{};
   enter_level(level_ + 1);
   level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
   if (contact) {
@@ -342,6 +339,11 @@ void ProgressiveSimulation::refine() {
                            expansion.collapses, to_next_[level_ - 1].apply_linear(coarse), next,
                            level_, stats);
     refinements_.push_back(stats);
+  }
+  if (strain_limited) {
+    std::vector<bool> inserted(next.size() / 3, false);
+    for (const auto& [removed, survivor] : expansion.collapses) inserted[removed] = true;
+    strain_corrections_.push_back(correct_strain_limits(level_system(), inserted, level_, next));
   }
   x_ = std::move(next);
   previous_ = x_;

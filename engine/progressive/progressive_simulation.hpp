@@ -32,6 +32,7 @@
 #include "engine/progressive/level_stepper.hpp"
 #include "engine/progressive/proxy_objective.hpp"
 #include "engine/progressive/safe_refinement.hpp"
+#include "engine/progressive/strain_limit_correction.hpp"
 #include "engine/progressive/system_prolongation.hpp"
 
 namespace psq {
@@ -114,6 +115,11 @@ class ProgressiveSimulation {
   [[nodiscard]] const std::vector<MeshHierarchy>& hierarchies() const { return hierarchies_; }
   /// What each refinement's safe initialization did (contact scenes; in refinement order).
   [[nodiscard]] const std::vector<RefinementStats>& refinements() const { return refinements_; }
+  /// What each refinement's strain-limit correction did (scenes with a strain limit; in
+  /// refinement order).
+  [[nodiscard]] const std::vector<StrainCorrectionStats>& strain_corrections() const {
+    return strain_corrections_;
+  }
 
   /// Current positions of the current level (flat, 3n).
   [[nodiscard]] const Eigen::VectorXd& positions() const { return x_; }
@@ -174,6 +180,7 @@ class ProgressiveSimulation {
   std::vector<SystemProlongation> to_finest_;
   std::vector<SystemProlongation> to_next_;
   std::vector<RefinementStats> refinements_;
+  std::vector<StrainCorrectionStats> strain_corrections_;
 
   int level_ = 0;
   int frame_ = 0;

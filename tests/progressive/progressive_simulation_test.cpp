@@ -64,17 +64,6 @@ TEST(ProgressiveSimulation, OneLevelIsExactlyTheQuasistaticSimulation) {
   EXPECT_EQ(progressive.frame(), twist.scene.time.frames);
 }
 
-TEST(ProgressiveSimulation, RefusesAStrainLimitedSceneNamingTheKey) {
-  const Scene scene = read_scene(test::source_dir() / "jobs/scenes/hanging_sheet.toml");
-  try {
-    ProgressiveSimulation sim(scene, two_levels(scene), {});
-    FAIL() << "a scene with a strain limit was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("'strain_limit'"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("levels = 1"), std::string::npos) << e.what();
-  }
-}
-
 /// Runs `sim` (two levels) through, then a direct fine solve and a direct solve of the coarsest
 /// mesh with its own elastics; asserts the finest answer within 1e-3 × bbox diagonal of the
 /// direct fine one, and the coarsest preview, prolonged, closer to it than `preview_factor` ×
