@@ -17,6 +17,7 @@
 #include "engine/contact/contact_potential.hpp"
 #include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
+#include "engine/progressive/target_relaxation.hpp"
 #include "engine/sim/contact_term.hpp"
 
 namespace psq {
@@ -569,6 +570,14 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   phase = Clock::now();
   stats.ccd_rounds += advance(full, surface.may_touch, ccd, safe_gap, y, goal - y);
   stats.ccd_seconds += since(phase);
+
+  // Vertices the advances stopped short, and pairs left closer than g, are relaxed (§4.4.3).
+  Eigen::VectorXd relaxed = flat(y);
+  const RelaxationStats relaxation = relax_toward_targets(fine, target, safe_gap, relaxed);
+  y = as_positions(relaxed);
+  stats.relaxed_vertices = relaxation.vertices;
+  stats.relax_iterations = relaxation.iterations;
+  stats.relax_seconds = relaxation.seconds;
 
   phase = Clock::now();
   const std::vector<int> bad = intersecting_vertices(full, y, surface.may_touch);

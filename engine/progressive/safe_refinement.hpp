@@ -31,7 +31,9 @@
 //      g). The advance is repeated: each round moves every vertex by the smallest safe
 //      fraction, then stops the vertices of the pairs that limited it, and the others go on
 //      (§4.4.4).
-// After the last colour every vertex advances toward its target the same way. The result is
+// After the last colour every vertex advances toward its target the same way, and the vertices
+// the advances stopped short, with those of pairs left closer than g, are relaxed toward their
+// targets with the barrier (patch relaxation, §4.4.3, target_relaxation.hpp). The result is
 // checked once more with exact predicates; every step of the way is intersection-free by
 // construction, the final check is the independent judge.
 //
@@ -61,6 +63,9 @@ struct RefinementStats {
   double perturb_seconds = 0.0;   ///< perturbations and their exact checks
   double ccd_seconds = 0.0;       ///< CCD advances
   double check_seconds = 0.0;     ///< the final exact check
+  int relaxed_vertices = 0;       ///< vertices the patch relaxation freed (target_relaxation.hpp)
+  int relax_iterations = 0;       ///< its Newton iterations
+  double relax_seconds = 0.0;     ///< its time
   double seconds = 0.0;           ///< the whole initialization
 };
 

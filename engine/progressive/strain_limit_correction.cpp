@@ -10,6 +10,7 @@
 #include <string>
 
 #include "engine/core/error.hpp"
+#include "engine/progressive/target_relaxation.hpp"
 #include "engine/solver/newton.hpp"
 
 namespace psq {
@@ -170,13 +171,9 @@ StrainCorrectionStats correct_strain_limits(const ShellSystem& fine,
   const auto solve = [&](const DofMap& dofs) {
     if (dofs.free_size() == 0) return;
     if (contact) {
-      // IPC's κ from the balance with the excess's gradient; the Hessian's scale is that of
-      // the Gauss–Newton blocks, of order one, where IPC's is m/Δt².
       Eigen::VectorXd g;
       excess.excess_gradient(x, g);
-      std::vector<bool> free(x.size());
-      for (Eigen::Index i = 0; i < x.size(); ++i) free[i] = dofs.reduced(i) >= 0;
-      contact->initialize_stiffness(x, g, free, 1.0 / contact->average_mass());
+      balance_barrier_stiffness(*contact, x, g, dofs);
     }
     double sigma = excess.tightest(x).sigma;
     for (int done = 0; done < kMaxIterations; done += kCheckEvery) {

@@ -205,7 +205,9 @@ void print_refinements(const std::string& name, const ProgressiveRun& run) {
               << " batches, " << r.perturbation_retries << " retries, " << r.ccd_rounds
               << " CCD rounds, gap " << r.smallest_gap << " m, final gap " << r.final_gap
               << " m, target distance max " << r.max_target_distance << " mean "
-              << r.mean_target_distance << " m, " << r.seconds << " s\n";
+              << r.mean_target_distance << " m, relaxed " << r.relaxed_vertices << " vertices in "
+              << r.relax_iterations << " iterations (" << r.relax_seconds << " s), CCD "
+              << r.ccd_seconds << " s, " << r.seconds << " s in all\n";
 }
 
 /// Every state intersection-free, one safe initialization per refinement.
