@@ -10,7 +10,7 @@
 #include <string>
 
 #include "engine/core/error.hpp"
-#include "engine/progressive/target_relaxation.hpp"
+#include "engine/progressive/local_solve.hpp"
 #include "engine/solver/newton.hpp"
 
 namespace psq {
@@ -45,17 +45,6 @@ LargestStretch largest_stretch(const TrianglePositions& x, const MembraneRest& r
   const Eigen::JacobiSVD<DeformationGradient> svd(deformation_gradient(x, rest),
                                                   Eigen::ComputeFullU | Eigen::ComputeFullV);
   return {svd.singularValues()[0], svd.matrixU().col(0) * svd.matrixV().col(0).transpose()};
-}
-
-/// The DOFs of every vertex that is pinned or not `movable` fixed.
-DofMap movable_dofs(const ShellSystem& system, const std::vector<bool>& movable) {
-  std::vector<bool> fixed(movable.size());
-  for (std::size_t v = 0; v < movable.size(); ++v) fixed[v] = !movable[v];
-  for (const PinnedVertex& pin : system.pinned()) fixed[pin.vertex] = true;
-  std::vector<int> fixed_vertices;
-  for (std::size_t v = 0; v < fixed.size(); ++v)
-    if (fixed[v]) fixed_vertices.push_back(static_cast<int>(v));
-  return DofMap(static_cast<Eigen::Index>(movable.size()), fixed_vertices);
 }
 
 }  // namespace
@@ -155,44 +144,48 @@ StrainCorrectionStats correct_strain_limits(const ShellSystem& fine,
   if (static_cast<Eigen::Index>(inserted.size()) != fine.rest_mesh().vertex_count())
     throw std::invalid_argument(fmt::format("correct_strain_limits: {} vertex marks for {} vertices",
                                             inserted.size(), fine.rest_mesh().vertex_count()));
-  std::unique_ptr<ContactTerm> contact;
-  if (contact_enabled(fine.scene())) contact = std::make_unique<ContactTerm>(fine);
-  StretchExcess excess(fine, x, contact.get());
+  StretchExcess excess(fine, x, nullptr);
   StrainCorrectionStats stats;
   const StretchExcess::Tightest start = excess.tightest(x);
   if (start.shell.empty()) return stats;
   stats.stretch_before = stats.stretch_after = start.sigma / start.limit;
   if (start.acceptable) return stats;
 
+  std::unique_ptr<ContactTerm> contact;
+  if (contact_enabled(fine.scene())) {
+    contact = std::make_unique<ContactTerm>(fine);
+    excess.set_contact(contact.get());
+  }
   NewtonSolver newton;
   NewtonSettings settings;
   settings.max_iterations = kCheckEvery;
   settings.tolerance = kCorrectionTolerance * bounding_box_diagonal(fine.rest_mesh().vertices);
+  // One solve over the free DOFs of `dofs`; returns the tightest triangle it ends with.
   const auto solve = [&](const DofMap& dofs) {
-    if (dofs.free_size() == 0) return;
+    StretchExcess::Tightest now = excess.tightest(x);
+    if (dofs.free_size() == 0) return now;
     if (contact) {
       Eigen::VectorXd g;
       excess.excess_gradient(x, g);
       balance_barrier_stiffness(*contact, x, g, dofs);
     }
-    double sigma = excess.tightest(x).sigma;
     for (int done = 0; done < kMaxIterations; done += kCheckEvery) {
+      const double sigma = now.sigma;
       const NewtonResult result = newton.minimize(excess, x, dofs, settings);
       stats.iterations += result.iterations;
-      const StretchExcess::Tightest now = excess.tightest(x);
-      if (now.acceptable || result.converged || result.stagnated) return;
+      now = excess.tightest(x);
+      if (now.acceptable || result.converged || result.stagnated) break;
       // The vertices this solve moves cannot take the tightest triangle back any further.
-      if (sigma - now.sigma < kLeastProgress * (sigma - now.accepted)) return;
-      sigma = now.sigma;
+      if (sigma - now.sigma < kLeastProgress * (sigma - now.accepted)) break;
       if (contact) contact->update_stiffness(x, false);
     }
+    return now;
   };
-  solve(movable_dofs(fine, inserted));
-  if (!excess.tightest(x).acceptable) {
+  StretchExcess::Tightest end = solve(movable_vertex_dofs(fine, inserted));
+  if (!end.acceptable) {
     stats.freed_old_vertices = true;
-    solve(movable_dofs(fine, std::vector<bool>(inserted.size(), true)));
+    end = solve(movable_vertex_dofs(fine, std::vector<bool>(inserted.size(), true)));
   }
-  const StretchExcess::Tightest end = excess.tightest(x);
   stats.stretch_after = end.sigma / end.limit;
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

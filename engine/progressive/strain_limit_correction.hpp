@@ -40,8 +40,10 @@ class StretchExcess final : public Objective {
     bool acceptable = true; ///< σ₁ ≤ s̄ − kCorrectionSlack·δ for every limited triangle
   };
 
-  /// `contact` may be null (no CCD) and must outlive this objective.
+  /// `contact` may be null (no barrier, no CCD) and must outlive this objective.
   StretchExcess(const ShellSystem& system, Eigen::VectorXd start, ContactTerm* contact);
+  /// Adds the barrier and CCD of `contact` (null: removes them) from here on.
+  void set_contact(ContactTerm* contact) { contact_ = contact; }
 
   [[nodiscard]] Eigen::Index size() const override { return start_.size(); }
   double value(const Eigen::VectorXd& x) override;

@@ -2,8 +2,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <set>
 
+#include "engine/progressive/local_solve.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/newton.hpp"
 
@@ -18,14 +18,6 @@ constexpr int kMaxIterations = 50;
 constexpr double kRelaxTolerance = 1e-2;
 
 }  // namespace
-
-void balance_barrier_stiffness(ContactTerm& contact, const Eigen::VectorXd& x,
-                               const Eigen::VectorXd& gradient, const DofMap& dofs) {
-  std::vector<bool> free(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) free[i] = dofs.reduced(i) >= 0;
-  // IPC's κ_min scales with the Hessian's diagonal, which it takes as m̄/Δt²; here it is one.
-  contact.initialize_stiffness(x, gradient, free, 1.0 / contact.average_mass());
-}
 
 TargetPull::TargetPull(Eigen::VectorXd target, ContactTerm& contact)
     : target_(std::move(target)), contact_(contact) {}
@@ -54,24 +46,19 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
   const auto started = std::chrono::steady_clock::now();
   ContactTerm contact(fine);
   const double reach = contact.potential().parameters().band.activation_distance;
-  std::set<int> freed;
   const Eigen::Index n = x.size() / 3;
+  std::vector<bool> freed(n, false);
   if (strain_limit_enabled(fine.scene()))
     for (Eigen::Index v = 0; v < n; ++v)
-      if ((x.segment<3>(3 * v) - target.segment<3>(3 * v)).norm() > reach)
-        freed.insert(static_cast<int>(v));
+      freed[v] = (x.segment<3>(3 * v) - target.segment<3>(3 * v)).norm() > reach;
   for (const ContactPair& pair : contact.potential().active_pairs(x))
     if (std::sqrt(pair_distance(pair, x)) < safe_gap)
-      for (int v : pair.vertices) freed.insert(v);
-  for (const PinnedVertex& pin : fine.pinned()) freed.erase(pin.vertex);
+      for (int v : pair.vertices) freed[v] = true;
+  const DofMap dofs = movable_vertex_dofs(fine, freed);
 
   RelaxationStats stats;
-  stats.vertices = static_cast<int>(freed.size());
-  if (freed.empty()) return stats;
-  std::vector<int> fixed;
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (!freed.contains(static_cast<int>(v))) fixed.push_back(static_cast<int>(v));
-  const DofMap dofs(n, fixed);
+  stats.vertices = static_cast<int>(dofs.free_size() / 3);
+  if (stats.vertices == 0) return stats;
   balance_barrier_stiffness(contact, x, x - target, dofs);
 
   TargetPull pull(target, contact);

@@ -1,8 +1,7 @@
 #pragma once
 // Patch relaxation of a safe initialization (paper §4.4.3). The CCD advances of
 // safe_refinement.hpp stop each vertex of a limiting pair where the pair limited it, so pairs can
-// end closer than the safe gap g (on the CI twist, 4.5e-18 m), which the level's barrier then
-// meets at its singular end. The relaxation frees the vertices of pairs closer than g and
+// end far closer than the safe gap g, which the level's barrier then meets at its singular end. The relaxation frees the vertices of pairs closer than g and
 // minimizes
 //   R(y) = ½ Σ_v ‖y_v − t_v‖² + κ B(y)
 // over them, t the prolonged targets, B the scene's contact barrier with κ from IPC's balance
@@ -12,8 +11,8 @@
 // With a strain limit it also frees the stragglers, the vertices farther than d̂ from their
 // targets: a vertex whose target lies beyond an obstacle (a child of cloth resting on a sphere,
 // whose target dips below the sphere's facets) stays near its parent, up to a coarse edge away,
-// and its triangles are stretched several times over (σ₁ ≈ 6 on a draped cloth), more than the
-// strain-limit correction can take back against the contact. Without a strain limit the level's
+// and its triangles are stretched several times over, more than the strain-limit correction
+// can take back against the contact. Without a strain limit the level's
 // solve corrects such elements with its own physics, and a pull toward the targets would only
 // change its path. Every accepted step is intersection-free by the CCD; the caller's exact check
 // stays the judge.
@@ -23,16 +22,9 @@
 
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/shell_system.hpp"
-#include "engine/solver/dof_map.hpp"
 #include "engine/solver/objective.hpp"
 
 namespace psq {
-
-/// Sets the contact term's κ by IPC's initial rule at x, balancing the barrier against
-/// `gradient` (the rest of the objective's gradient) over the free DOFs of `dofs`, for an
-/// objective whose Hessian is of order one per DOF (not m/Δt²).
-void balance_barrier_stiffness(ContactTerm& contact, const Eigen::VectorXd& x,
-                               const Eigen::VectorXd& gradient, const DofMap& dofs);
 
 /// R above over a system's vertices.
 class TargetPull final : public Objective {
