@@ -16,6 +16,7 @@
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/quasistatic.hpp"
+#include "progressive/reference_runs.hpp"
 
 namespace psq {
 namespace {
@@ -181,15 +182,7 @@ ProgressiveRun run_checked(const Scene& scene, int levels) {
     run.intersecting += intersections(sim.level_system(), sim.positions()) > 0;
   };
   check();
-  for (;;) {
-    while (!sim.level_done()) {
-      sim.step();
-      check();
-    }
-    if (sim.finished()) break;
-    sim.refine();
-    check();
-  }
+  test::run_to_end(sim, check);
   run.converged = sim.level_converged();
   run.finest = sim.positions();
   run.refinements = sim.refinements();
@@ -258,10 +251,7 @@ TEST(ProgressiveContact, PressMatchesTheDirectFineEquilibrium) {
   while (direct.frame() < direct.frame_count()) converged = direct.step().newton.converged && converged;
   ASSERT_TRUE(converged);
   const double diagonal = bounding_box_diagonal(direct.system().rest_mesh().vertices);
-  const double distance = (as_positions(progressive.finest) - as_positions(direct.positions()))
-                              .rowwise()
-                              .norm()
-                              .maxCoeff();
+  const double distance = test::max_vertex_distance(progressive.finest, direct.positions());
   std::cout << "press: progressive vs direct fine equilibrium " << distance << " m, "
             << distance / diagonal << " of the diagonal\n";
   EXPECT_LT(distance, 1e-3 * diagonal);
@@ -281,13 +271,6 @@ TEST(ProgressiveContact, ResumingBetweenStepsEndsExactlyLikeTheUninterruptedRun)
   };
   const auto store = [](const ProgressiveSimulation& sim) {
     return Stored{sim.level(), sim.frame(), sim.positions(), sim.previous(), sim.schedule_state()};
-  };
-  const auto finish = [](ProgressiveSimulation& sim) {
-    for (;;) {
-      while (!sim.level_done()) sim.step();
-      if (sim.finished()) return;
-      sim.refine();
-    }
   };
   ProgressiveSimulation uninterrupted(scene, settings);
   std::vector<Stored> between_steps;
@@ -309,7 +292,7 @@ TEST(ProgressiveContact, ResumingBetweenStepsEndsExactlyLikeTheUninterruptedRun)
     ProgressiveSimulation resumed(scene, settings);
     resumed.restore(stored.level, stored.frame, stored.positions, stored.previous, 0,
                     stored.schedule);
-    finish(resumed);
+    test::run_to_end(resumed);
     EXPECT_EQ((resumed.positions() - uninterrupted.positions()).lpNorm<Eigen::Infinity>(), 0.0);
   }
 }

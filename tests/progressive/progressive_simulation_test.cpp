@@ -209,15 +209,6 @@ TEST(ProgressiveSimulation, RestoreResumesWhereTheStoredStateLeftOff) {
                std::invalid_argument);  // level 1 has the fine mesh's unknowns
 }
 
-/// Runs the schedule from the current state to its end.
-void finish(ProgressiveSimulation& sim) {
-  while (true) {
-    run_level(sim);
-    if (sim.finished()) return;
-    sim.refine();
-  }
-}
-
 /// What a checkpoint stores of a progressive run.
 struct StoredState {
   int level = 0, frame = 0, iterations_in_frame = 0;
@@ -255,7 +246,7 @@ TEST(ProgressiveSimulation, ResumingAnyStoredIterateEndsExactlyLikeTheUninterrup
     ProgressiveSimulation resumed(twist.scene, settings, {twist.hierarchy});
     resumed.restore(stored.level, stored.frame, stored.positions, stored.previous,
                     stored.iterations_in_frame, stored.schedule);
-    finish(resumed);
+    test::run_to_end(resumed);
     EXPECT_LE((resumed.positions() - uninterrupted.positions()).lpNorm<Eigen::Infinity>(), 1e-12);
   };
   // Inside steps: preview frames, settling at the refine frame, the finest level's frames.

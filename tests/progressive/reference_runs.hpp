@@ -4,8 +4,10 @@
 // equilibrium criterion the progressive solver uses at its refine frame.
 
 #include <Eigen/Core>
+#include <functional>
 
 #include "engine/progressive/level_stepper.hpp"
+#include "engine/progressive/progressive_simulation.hpp"
 
 namespace psq::test {
 
@@ -39,6 +41,20 @@ inline DirectRun settled_direct_run(const ShellSystem& system, double tolerance,
         k, (run.positions - before).lpNorm<Eigen::Infinity>() / scene.time.step, tolerance);
   }
   return run;
+}
+
+/// Runs the schedule of `sim` from its current state to its end, calling `check` (when given)
+/// after every step and every refinement.
+inline void run_to_end(ProgressiveSimulation& sim, const std::function<void()>& check = {}) {
+  for (;;) {
+    while (!sim.level_done()) {
+      sim.step();
+      if (check) check();
+    }
+    if (sim.finished()) return;
+    sim.refine();
+    if (check) check();
+  }
 }
 
 /// Largest distance between corresponding vertices of two flat position vectors.

@@ -14,6 +14,7 @@
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "engine/sim/strain_limit_term.hpp"
+#include "progressive/reference_runs.hpp"
 #include "support/derivative_check.hpp"
 #include "support/test_paths.hpp"
 
@@ -131,9 +132,10 @@ TEST(StrainLimitCorrection, MovesOnlyTheInsertedVerticesBelowTheLimit) {
   EXPECT_GT(stats.stretch_before, 1.0);
   // Every triangle keeps at least a tenth of the band (δ = 0.05) as slack.
   EXPECT_GE(min_slack(system, x), 0.1 * (kLimit - 1) * (1 - 1e-9));
-  for (std::size_t v = 0; v < inserted.size(); ++v)
-    if (!inserted[v])
-      EXPECT_EQ((x.segment<3>(3 * v) - before.segment<3>(3 * v)).norm(), 0.0) << v;
+  for (std::size_t v = 0; v < inserted.size(); ++v) {
+    if (inserted[v]) continue;
+    EXPECT_EQ((x.segment<3>(3 * v) - before.segment<3>(3 * v)).norm(), 0.0) << v;
+  }
 }
 
 TEST(StrainLimitCorrection, LeavesAFeasibleStateAlone) {
@@ -189,15 +191,7 @@ TEST(ProgressiveStrainLimit, HangingSheetStaysWithinTheLimitAtEveryLevelAndMatch
     smallest_slack = std::min(smallest_slack, min_slack(sim.level_system(), sim.positions()));
   };
   check();
-  for (;;) {
-    while (!sim.level_done()) {
-      sim.step();
-      check();
-    }
-    if (sim.finished()) break;
-    sim.refine();
-    check();
-  }
+  test::run_to_end(sim, check);
   ASSERT_TRUE(sim.level_converged());
   ASSERT_EQ(sim.strain_corrections().size(), 2u);
   for (const StrainCorrectionStats& c : sim.strain_corrections())
@@ -210,8 +204,7 @@ TEST(ProgressiveStrainLimit, HangingSheetStaysWithinTheLimitAtEveryLevelAndMatch
   QuasistaticSimulation direct(scene);
   while (direct.frame() < direct.frame_count()) ASSERT_TRUE(direct.step().newton.converged);
   const double diagonal = bounding_box_diagonal(direct.system().rest_mesh().vertices);
-  const double distance =
-      (as_positions(sim.positions()) - as_positions(direct.positions())).rowwise().norm().maxCoeff();
+  const double distance = test::max_vertex_distance(sim.positions(), direct.positions());
   std::cout << "hanging sheet: progressive vs direct " << distance / diagonal
             << " of the diagonal\n";
   EXPECT_LT(distance, 1e-3 * diagonal);
