@@ -105,6 +105,9 @@ struct LevelRecord {
   /// (frame, static residual ‖d‖∞/Δt) of each frame whose answer was settled to a static
   /// equilibrium (engine/sim/settling.hpp), in frame order (NaN allowed: stored as null).
   std::vector<std::pair<int, double>> static_residuals;
+  /// What the refinement into this level did, by name (engine/progressive/
+  /// refinement_statistics.hpp); empty at level 0 and for a direct solve.
+  std::map<std::string, double> refinement;
   std::string checkpoint_path;            ///< empty if none
   std::string checkpoint_checksum;        ///< of the checkpoint file; empty if none
   std::string error;                      ///< empty unless failed

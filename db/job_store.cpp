@@ -87,11 +87,27 @@ Job read_job(const Statement& row) {
 
 constexpr const char* kLevelColumns =
     "level, status, iterations, residuals, timings, checkpoint_path, checkpoint_checksum, "
-    "error, attempt, updated_at, static_residuals";
+    "error, attempt, updated_at, static_residuals, refinement";
 
 /// A stored number: JSON has no NaN or infinity, nlohmann writes them as null, read back as NaN.
 double stored_number(const nlohmann::json& value) {
   return value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Named numbers as the text of a JSON object ({} when there are none).
+std::string named_numbers_json(const std::map<std::string, double>& named) {
+  nlohmann::json object = nlohmann::json::object();
+  for (const auto& [name, value] : named) object[name] = value;
+  return object.dump();
+}
+
+/// A JSON object of named numbers (timings, refinement statistics).
+std::map<std::string, double> stored_named_numbers(const std::string& text) {
+  std::map<std::string, double> named;
+  const nlohmann::json object = nlohmann::json::parse(text);
+  for (const auto& [name, value] : object.items())
+    named[name] = stored_number(value);
+  return named;
 }
 
 /// Reads the level columns starting at column `first`.
@@ -102,9 +118,7 @@ LevelRecord read_level(const Statement& row, int first) {
   level.iterations = row.integer(first + 2);
   for (const auto& residual : nlohmann::json::parse(row.text(first + 3)))
     level.residuals.push_back(stored_number(residual));
-  const auto timings = nlohmann::json::parse(row.text(first + 4));
-  for (const auto& [phase, seconds] : timings.items())
-    level.timings[phase] = stored_number(seconds);
+  level.timings = stored_named_numbers(row.text(first + 4));
   level.checkpoint_path = row.text(first + 5);
   level.checkpoint_checksum = row.text(first + 6);
   level.error = row.text(first + 7);
@@ -112,6 +126,7 @@ LevelRecord read_level(const Statement& row, int first) {
   level.updated_at = row.real(first + 9);
   for (const auto& frame : nlohmann::json::parse(row.text(first + 10)))
     level.static_residuals.emplace_back(frame.at(0).get<int>(), stored_number(frame.at(1)));
+  level.refinement = stored_named_numbers(row.text(first + 11));
   return level;
 }
 
@@ -316,8 +331,6 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
   if (level.level < 0 || level.level >= depth)
     throw std::invalid_argument(
         fmt::format("job {}: level {} outside [0, {})", lease.job_id, level.level, depth));
-  nlohmann::json timings = nlohmann::json::object();
-  for (const auto& [phase, seconds] : level.timings) timings[phase] = seconds;
   const auto path = unless_empty(level.checkpoint_path);
   const auto checksum = unless_empty(level.checkpoint_checksum);
   // Progress is a checkpoint the level's row did not hold yet. A resumed attempt records again
@@ -334,12 +347,13 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
   connection_
       .prepare(
           "REPLACE INTO levels (job_id, level, status, iterations, residuals, timings, "
-          "checkpoint_path, checkpoint_checksum, error, attempt, updated_at, static_residuals) "
-          "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)")
+          "checkpoint_path, checkpoint_checksum, error, attempt, updated_at, static_residuals, "
+          "refinement) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)")
       .bind_all(lease.job_id, level.level, to_string(level.status), level.iterations,
-                nlohmann::json(level.residuals).dump(), timings.dump(), path, checksum,
-                unless_empty(level.error), lease.attempt, now(),
-                nlohmann::json(level.static_residuals).dump())
+                nlohmann::json(level.residuals).dump(), named_numbers_json(level.timings),
+                path, checksum, unless_empty(level.error), lease.attempt, now(),
+                nlohmann::json(level.static_residuals).dump(),
+                named_numbers_json(level.refinement))
       .run();
   if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();

@@ -110,12 +110,19 @@ ALTER TABLE jobs ADD COLUMN progress_attempt INTEGER;
 ALTER TABLE jobs ADD COLUMN stalls INTEGER NOT NULL DEFAULT 0 CHECK (stalls >= 0);
 )sql";
 
+// What the refinement into each level did (safe initialization, strain-limit correction), by
+// name: a JSON object of numbers.
+constexpr const char* kRefinementStatistics = R"sql(
+ALTER TABLE levels ADD COLUMN refinement TEXT NOT NULL DEFAULT '{}';
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
     Migration{2, "static residuals of the settled frames of each level", kStaticResiduals},
     Migration{3, "SLURM array tasks holding jobs", kSlurmTasks},
     Migration{4, "progress-aware retries: progress_attempt, stalls", kProgressAwareRetries},
+    Migration{5, "refinement statistics of each level", kRefinementStatistics},
 };
 
 constexpr const char* kVersionTable = R"sql(

@@ -40,7 +40,7 @@ class DirectLevelSolver final : public LevelSolver {
             .times = record.newton.times};
   }
 
-  void refine() override {
+  void refine(const RefinementPhase&) override {
     throw std::logic_error("DirectLevelSolver::refine: a direct solve has one level");
   }
 
@@ -92,7 +92,10 @@ class ProgressiveLevelSolver final : public LevelSolver {
             .elastic_energy = step.frame.elastic_energy,
             .times = newton.times};
   }
-  void refine() override { simulation_.refine(); }
+  void refine(const RefinementPhase& phase) override { simulation_.refine(phase); }
+  std::map<std::string, double> refinement_statistics() const override {
+    return simulation_.refinement_statistics();
+  }
   const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
   const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
   const TriMesh& level_rest_mesh() const override { return simulation_.level_rest_mesh(); }

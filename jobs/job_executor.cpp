@@ -146,7 +146,7 @@ class JobRun {
       while (true) {
         if (!solver_->level_done()) solve_level();  // a resumed level may be done already
         if (solver_->finished()) break;
-        solver_->refine();
+        refine();
         start_level();
       }
       test_point("before_finish");
@@ -226,8 +226,22 @@ class JobRun {
       record_finished_level(candidate.file, verified_checksum(candidate));
   }
 
+  /// Refines to the next level, logging each phase. Nothing is written until the new level's
+  /// first checkpoint, so a worker killed here resumes from the level being refined.
+  void refine() {
+    const int next = solver_->level() + 1;
+    solver_->refine([&](const std::string& phase) {
+      log(fmt::format("refining to level {}: {}", next, phase));
+      test_point("refinement_phase");
+      if (heartbeat_.lost()) throw LeaseLost{};
+      // The finished level's checkpoint is the place to resume from: nothing to write.
+      if (stop_.load()) throw StopRequested{};
+    });
+  }
+
   void start_level() {
     statistics_ = {};
+    statistics_.refinement = solver_->refinement_statistics();
     frame_energy_.reset();
     level_start_ = Clock::now();
     since_checkpoint_ = Clock::now();
@@ -411,6 +425,7 @@ class JobRun {
     for (const IterationRecord& it : statistics_.iterations)
       level.residuals.push_back(it.gradient_norm);
     level.timings = statistics_.timings;
+    level.refinement = statistics_.refinement;
     if (solver_) level.static_residuals = static_residuals(statistics_.iterations, *solver_);
     if (!file.empty()) {
       level.checkpoint_path = fs::absolute(file).lexically_normal().string();

@@ -50,8 +50,16 @@ class LevelSolver {
   [[nodiscard]] virtual bool finished() const = 0;
   /// Solves the next frame of the current level. Throws NumericalError on a numerical failure.
   virtual LevelFrame step(const Progress& progress) = 0;
-  /// Moves to the next finer level, initialized from the current one. Requires level_done().
-  virtual void refine() = 0;
+  /// Told each phase of a refinement as it starts (engine/progressive/safe_refinement.hpp).
+  using RefinementPhase = std::function<void(const std::string& phase)>;
+  /// Moves to the next finer level, initialized from the current one, telling `phase` each
+  /// phase of the work. Requires level_done().
+  virtual void refine(const RefinementPhase& phase) = 0;
+  /// What the refinement into the current level did, by name (engine/progressive/
+  /// refinement_statistics.hpp); empty at level 0, for a direct solve and after restore().
+  [[nodiscard]] virtual std::map<std::string, double> refinement_statistics() const {
+    return {};
+  }
   /// The current level's positions (3n, flat); the current iterate during step().
   [[nodiscard]] virtual const Eigen::VectorXd& positions() const = 0;
   /// xᵗ of the frame being (or last) solved.

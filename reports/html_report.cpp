@@ -164,6 +164,8 @@ std::string html_report(const SweepReport& report, Gnuplot& gnuplot) {
   std::string body = overview(report);
   body += "<h2>Jobs</h2>\n" + html_table(jobs_table(report));
   body += "<h2>Levels</h2>\n" + html_table(levels_table(report));
+  if (const Table refinements = refinements_table(report); !refinements.rows.empty())
+    body += "<h2>Refinements</h2>\n" + html_table(refinements);
   body += problems_section(report);
   body += sweep_figures(page, plots);
   for (const JobReport& job : report.jobs)

@@ -50,6 +50,7 @@ LevelReport level_from_record(const db::LevelRecord& record) {
   level.static_residuals = record.static_residuals;
   if (!record.static_residuals.empty() && std::isfinite(record.static_residuals.back().second))
     level.static_residual = record.static_residuals.back().second;
+  level.refinement = record.refinement;
   level.checkpoint = record.checkpoint_path;
   level.error = record.error;
   return level;

@@ -44,6 +44,9 @@ struct LevelReport {
   /// max_i ‖P(x_l)_i − x_L,i‖ / diag(x_L): this level's state prolonged to the finest mesh
   /// against the finest level's converged state, relative to the latter's bounding box.
   std::optional<double> error_to_finest;
+  /// What the refinement into this level did, by name, as stored (engine/progressive/
+  /// refinement_statistics.hpp); empty at level 0 and for a direct solve.
+  std::map<std::string, double> refinement;
   std::string checkpoint;           ///< as recorded in the store; empty if none
   std::string error;                ///< the level's failure message, if it failed
   std::optional<LevelShape> shape;  ///< only for levels of finished jobs with a readable checkpoint

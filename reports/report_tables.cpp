@@ -109,6 +109,43 @@ Table levels_table(const SweepReport& report) {
   return table;
 }
 
+Table refinements_table(const SweepReport& report) {
+  // (column, statistic) in the order shown; refinement_statistics.hpp names the statistics.
+  static const std::vector<std::pair<std::string, std::string>> columns{
+      {"expansions", "expansions"},
+      {"retries", "perturbation_retries"},
+      {"CCD rounds", "ccd_rounds"},
+      {"relaxed vertices", "relaxed_vertices"},
+      {"smallest gap (m)", "smallest_gap"},
+      {"final gap (m)", "final_gap"},
+      {"max target distance (m)", "max_target_distance"},
+      {"mean target distance (m)", "mean_target_distance"},
+      {"stretch before", "stretch_before"},
+      {"stretch after", "stretch_after"},
+      {"gap (s)", "gap_seconds"},
+      {"perturb (s)", "perturb_seconds"},
+      {"CCD (s)", "ccd_seconds"},
+      {"relax (s)", "relax_seconds"},
+      {"check (s)", "check_seconds"},
+      {"strain (s)", "strain_seconds"},
+      {"total (s)", "seconds"}};
+  Table table;
+  table.header = {"#", "level"};
+  for (const auto& [column, statistic] : columns) table.header.push_back(column);
+  for (const JobReport& job : report.jobs)
+    for (const LevelReport& level : job.levels) {
+      if (level.refinement.empty()) continue;
+      std::vector<std::string> row{std::to_string(job.number), std::to_string(level.level)};
+      for (const auto& [column, statistic] : columns) {
+        const auto found = level.refinement.find(statistic);
+        row.push_back(found == level.refinement.end() ? std::string()
+                                                      : readable_number(found->second));
+      }
+      table.rows.push_back(std::move(row));
+    }
+  return table;
+}
+
 std::string to_csv(const Table& table) {
   const auto field = [](const std::string& text) {
     if (text.find_first_of(",\"\r\n") == std::string::npos) return text;

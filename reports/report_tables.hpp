@@ -28,6 +28,13 @@ Table jobs_table(const SweepReport& report);
 /// to the finest level, checkpoint.
 Table levels_table(const SweepReport& report);
 
+/// One row per job level entered by a refinement that recorded statistics: number, level,
+/// expansions, perturbation retries, CCD rounds, relaxed vertices, smallest and final gap,
+/// largest and mean distance of the initializer from its prolonged target, the strain-limit
+/// correction's stretch before and after, and the seconds of each phase and in all. No rows when
+/// no level was refined (direct solves, or scenes without contact and strain limits).
+Table refinements_table(const SweepReport& report);
+
 /// RFC 4180 CSV: fields with a comma, quote or line break are quoted, quotes doubled; lines
 /// end with CRLF.
 std::string to_csv(const Table& table);

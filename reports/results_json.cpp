@@ -24,6 +24,7 @@ nlohmann::json level_json(const LevelReport& level) {
           {"static_residual", number_or_null(level.static_residual)},
           {"static_residuals", static_residuals},
           {"error_to_finest", number_or_null(level.error_to_finest)},
+          {"refinement", level.refinement},
           {"checkpoint", level.checkpoint},
           {"error", level.error},
           {"residuals", residuals}};

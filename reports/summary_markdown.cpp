@@ -15,6 +15,8 @@ std::string summary_markdown(const SweepReport& report) {
   text += to_markdown(counts);
   text += "\n## Jobs\n\n" + to_markdown(jobs_table(report));
   text += "\n## Levels\n\n" + to_markdown(levels_table(report));
+  if (const Table refinements = refinements_table(report); !refinements.rows.empty())
+    text += "\n## Refinements\n\n" + to_markdown(refinements);
   std::string problems;
   for (const JobReport& job : report.jobs)
     for (const std::string& problem : job.problems)

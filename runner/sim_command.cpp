@@ -215,11 +215,14 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
     write_positions(out / fmt::format("level_{}.obj", sim.level()), sim.level_rest_mesh(),
                     sim.positions());
     levels.push_back(level.json());
-    const std::vector<RefinementStats>& refinements = sim.refinements();
-    if (!refinements.empty() && refinements.back().level == sim.level())
-      levels.back()["refinement"] = refinement_json(refinements.back());
+    if (!sim.refinement_statistics().empty())
+      levels.back()["refinement"] = sim.refinement_statistics();
     if (sim.finished()) break;
-    sim.refine();
+    const int next = sim.level() + 1;
+    sim.refine([&](const std::string& phase) {
+      std::cerr << fmt::format("  refining to level {}/{}: {}\n", next, sim.level_count() - 1,
+                               phase);
+    });
   }
   nlohmann::json summary =
       run_summary(scene, rest, sim.finest_tolerance(), sim.level_count(), all_converged, frames);

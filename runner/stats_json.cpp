@@ -57,21 +57,4 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"phase_seconds", phase_times_json(r.newton.times)}};
 }
 
-nlohmann::json refinement_json(const RefinementStats& stats) {
-  return {{"expansions", stats.expansions},
-          {"batches", stats.batches},
-          {"perturbation_retries", stats.perturbation_retries},
-          {"ccd_rounds", stats.ccd_rounds},
-          {"smallest_gap", stats.smallest_gap},
-          {"final_gap", stats.final_gap},
-          {"max_target_distance", stats.max_target_distance},
-          {"mean_target_distance", stats.mean_target_distance},
-          {"seconds",
-           {{"gap", stats.gap_seconds},
-            {"perturb", stats.perturb_seconds},
-            {"ccd", stats.ccd_seconds},
-            {"check", stats.check_seconds},
-            {"total", stats.seconds}}}};
-}
-
 }  // namespace psq::runner

@@ -1,7 +1,6 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
-#include "engine/progressive/safe_refinement.hpp"
 #include "engine/sim/quasistatic.hpp"
 
 namespace psq::runner {
@@ -13,8 +12,5 @@ nlohmann::json contact_json(const FrameRecord& record);
 /// A frame's solve: convergence, energies, per-iteration residuals, time split, friction
 /// iterations and contact_json.
 nlohmann::json frame_json(const FrameRecord& record);
-/// What a refinement's safe initialization did: expansions, retries, CCD rounds, gaps, the
-/// initializer's distance from its prolonged target, and the time of each phase.
-nlohmann::json refinement_json(const RefinementStats& stats);
 
 }  // namespace psq::runner

@@ -121,6 +121,7 @@ std::uint64_t content_checksum(const Checkpoint& c, int schema_version) {
     for (const auto& [name, field] : real_columns) hash_value(hash, record.*field);
   }
   hash_named_values(hash, c.statistics.timings);
+  if (schema_version >= 3) hash_named_values(hash, c.statistics.refinement);
   return hash.value();
 }
 
@@ -147,8 +148,11 @@ std::optional<std::string> inconsistency(const Checkpoint& c) {
       !c.finest_positions.allFinite() || !c.solver.previous_positions.allFinite())
     return std::string("positions contain NaN or infinite values");
   if (!std::isfinite(c.time)) return std::string("the time is NaN or infinite");
-  if (!all_named_and_finite(c.solver.scalars) || !all_named_and_finite(c.statistics.timings))
-    return std::string("solver scalars or timings with an empty name or a non-finite value");
+  if (!all_named_and_finite(c.solver.scalars) || !all_named_and_finite(c.statistics.timings) ||
+      !all_named_and_finite(c.statistics.refinement))
+    return std::string(
+        "solver scalars, timings or refinement statistics with an empty name or a non-finite "
+        "value");
   if (c.level < 0 || c.frame < 0 || c.solver.iterations_in_frame < 0)
     return fmt::format("negative level ({}), frame ({}) or iteration count ({})", c.level, c.frame,
                        c.solver.iterations_in_frame);
@@ -194,6 +198,7 @@ void write_solver_state(hdf5::Group group, const SolverState& solver) {
 void write_statistics(hdf5::Group group, const LevelStatistics& statistics) {
   write_iterations(group.create_group("iterations"), statistics.iterations);
   write_named_values(group.create_group("timings"), statistics.timings);
+  write_named_values(group.create_group("refinement"), statistics.refinement);
 }
 
 /// Writes the checkpoint as an HDF5 file at `path`, flushed and closed.
@@ -305,6 +310,8 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   const hdf5::Group statistics = root.open_group("statistics");
   c.statistics.iterations = read_iterations(statistics.open_group("iterations"));
   c.statistics.timings = read_named_values(statistics.open_group("timings"));
+  if (c.schema_version >= 3)
+    c.statistics.refinement = read_named_values(statistics.open_group("refinement"));
 
   const auto stored_checksum = root.read_attribute<std::uint64_t>("content_checksum");
   if (content_checksum(c, c.schema_version) != stored_checksum)

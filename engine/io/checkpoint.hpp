@@ -18,7 +18,7 @@ namespace psq {
 
 /// Version of the checkpoint layout written by this program. Raise it whenever the layout or the
 /// content checksum changes; files of a newer version are refused.
-inline constexpr int checkpoint_schema_version = 2;
+inline constexpr int checkpoint_schema_version = 3;
 
 /// A checkpoint that cannot be written, or read back and trusted: missing, truncated, damaged,
 /// foreign or newer. The message names the file and what is wrong.
@@ -67,6 +67,10 @@ inline constexpr const char* kElasticEnergyScalar = "elastic_energy";
 struct LevelStatistics {
   std::vector<IterationRecord> iterations;  ///< every Newton iteration of the level, in order
   std::map<std::string, double> timings;    ///< seconds by phase (assembly, factorization, …)
+  /// What the refinement into this level did, by name (engine/progressive/
+  /// refinement_statistics.hpp); empty at level 0, for a direct solve, and in files of schema
+  /// version 2.
+  std::map<std::string, double> refinement;
 };
 
 /// The state of one job level at one moment.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
+#include "engine/progressive/refinement_statistics.hpp"
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 
@@ -319,12 +321,13 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   return out;
 }
 
-void ProgressiveSimulation::refine() {
+void ProgressiveSimulation::refine(const RefinementProgress& progress) {
   if (level_ + 1 >= level_count_)
     throw std::logic_error("ProgressiveSimulation::refine: already at the finest level");
   if (!level_done())
     throw std::logic_error(
         fmt::format("ProgressiveSimulation::refine: level {} is not done", level_));
+  const auto start = std::chrono::steady_clock::now();
   Eigen::VectorXd next = to_next_[level_].apply(x_);
   const Eigen::VectorXd coarse = x_;
   const bool contact = contact_enabled(finest_.scene());
@@ -333,21 +336,28 @@ void ProgressiveSimulation::refine() {
       contact || strain_limited ? system_expansion(level_) : Expansion{};
   enter_level(level_ + 1);
   level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
+  std::optional<RefinementStats> safe_initialization;
+  std::optional<StrainCorrectionStats> strain_correction;
   if (contact) {
-    RefinementStats stats;
+    safe_initialization.emplace();
     next = safe_initialize(level_system(), expansion.parent, expansion.color, coarse,
                            expansion.collapses, to_next_[level_ - 1].apply_linear(coarse), next,
-                           level_, stats);
-    refinements_.push_back(stats);
+                           level_, *safe_initialization, progress);
+    refinements_.push_back(*safe_initialization);
   }
   if (strain_limited) {
+    if (progress) progress("strain-limit correction");
     std::vector<bool> inserted(next.size() / 3, false);
     for (const auto& [removed, survivor] : expansion.collapses) inserted[removed] = true;
-    strain_corrections_.push_back(correct_strain_limits(level_system(), inserted, level_, next));
+    strain_correction = correct_strain_limits(level_system(), inserted, level_, next);
+    strain_corrections_.push_back(*strain_correction);
   }
   x_ = std::move(next);
   previous_ = x_;
   frame_start_ = x_;
+  entered_by_ = named_refinement_statistics(
+      safe_initialization, strain_correction,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
@@ -379,6 +389,7 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
     throw std::invalid_argument(fmt::format(
         "ProgressiveSimulation::restore: {} iterations in the frame", iterations_in_frame));
   enter_level(level);
+  entered_by_.clear();
   const Eigen::Index size = level_system().rest_mesh().vertices.size();
   if (positions.size() != size || previous.size() != size)
     throw std::invalid_argument(fmt::format(

@@ -133,9 +133,15 @@ class ProgressiveSimulation {
   [[nodiscard]] bool frame_settles(int frame) const;
   /// One quasistatic step of the schedule. @throws std::logic_error when level_done().
   ProgressiveStep step(const Progress& progress = {});
-  /// Moves to the next level from the current (done) one. @throws std::logic_error when the
-  /// level is not done or already the finest.
-  void refine();
+  /// Moves to the next level from the current (done) one, telling `progress` (if set) each
+  /// phase of the refinement as it starts. @throws std::logic_error when the level is not done
+  /// or already the finest.
+  void refine(const RefinementProgress& progress = {});
+  /// The statistics of the refinement that entered the current level, by name
+  /// (refinement_statistics.hpp); empty at level 0 and after a restore().
+  [[nodiscard]] const std::map<std::string, double>& refinement_statistics() const {
+    return entered_by_;
+  }
   /// The schedule's position within the current level besides the frame: what restore() needs
   /// to continue exactly (stored with checkpoints as named scalars).
   [[nodiscard]] std::map<std::string, double> schedule_state() const;
@@ -181,6 +187,7 @@ class ProgressiveSimulation {
   std::vector<SystemProlongation> to_next_;
   std::vector<RefinementStats> refinements_;
   std::vector<StrainCorrectionStats> strain_corrections_;
+  std::map<std::string, double> entered_by_;
 
   int level_ = 0;
   int frame_ = 0;

@@ -287,8 +287,12 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
                                 const std::vector<std::array<int, 2>>& collapses,
                                 const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
-                                int level, RefinementStats& stats) {
+                                int level, RefinementStats& stats,
+                                const RefinementProgress& progress) {
   const Clock::time_point start = Clock::now();
+  const auto tell = [&](const std::string& phase) {
+    if (progress) progress(phase);
+  };
   stats = RefinementStats{};
   stats.level = level;
   const ContactSurface surface = contact_surface(fine, fine.scene().contact.self_contact);
@@ -402,6 +406,8 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   stats.gap_seconds += since(phase);
   stats.smallest_gap = std::numeric_limits<double>::infinity();
   for (const auto& [batch_color, clusters] : batches) {
+    tell(fmt::format("batch {} of {}: {} clusters", stats.batches + 1, batches.size(),
+                     clusters.size()));
     phase = Clock::now();
     const double gap = mixed_gap(MixedMesh(surface, representative), surface.may_touch, y, cap);
     stats.gap_seconds += since(phase);
@@ -567,11 +573,13 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   // Every vertex the rest of the way, as far as it safely goes.
   const MixedMesh full(surface, representative);
   if (!std::isfinite(stats.smallest_gap)) stats.smallest_gap = safe_gap;
+  tell("advance");
   phase = Clock::now();
   stats.ccd_rounds += advance(full, surface.may_touch, ccd, safe_gap, y, goal - y);
   stats.ccd_seconds += since(phase);
 
   // Vertices the advances stopped short, and pairs left closer than g, are relaxed (§4.4.3).
+  tell("relaxation");
   Eigen::VectorXd relaxed = flat(y);
   const RelaxationStats relaxation = relax_toward_targets(fine, target, safe_gap, relaxed);
   y = as_positions(relaxed);
@@ -579,6 +587,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   stats.relax_iterations = relaxation.iterations;
   stats.relax_seconds = relaxation.seconds;
 
+  tell("exact check");
   phase = Clock::now();
   const std::vector<int> bad = intersecting_vertices(full, y, surface.may_touch);
   if (!bad.empty())

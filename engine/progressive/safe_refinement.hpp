@@ -42,11 +42,18 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "engine/sim/shell_system.hpp"
 
 namespace psq {
+
+/// Told the phase of a refinement as it starts ("batch 2 of 5: 40 clusters", "advance", …), for
+/// progress display; the refinement writes nothing, so a process killed inside it resumes from
+/// the level it refines.
+using RefinementProgress = std::function<void(const std::string& phase)>;
 
 /// What one refinement's safe initialization did.
 struct RefinementStats {
@@ -75,14 +82,15 @@ struct RefinementStats {
 /// level-l vertex k, `collapses` the collapses that made level l from level l+1 in order
 /// ((removed, survivor), level-(l+1) indices; HierarchyLevel::collapses), `anchors` the linear part U^l_{l+1} x_l of the prolongation (each vertex
 /// at its intrinsic place on the deformed level-l surface), `target` the prolonged state P^l_{l+1}(x_l) with the pinned vertices at
-/// their scripted positions. `level` (l+1) names the level in messages and stats.
+/// their scripted positions. `level` (l+1) names the level in messages and stats; `progress`
+/// (if set) is told each phase as it starts.
 /// @throws NumericalError naming the level and vertex when no intersection-free perturbation
 /// of a cluster is found, or when the final state fails the exact check.
 Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>& parent,
                                 const std::vector<int>& color, const Eigen::VectorXd& coarse_x,
                                 const std::vector<std::array<int, 2>>& collapses,
                                 const Eigen::VectorXd& anchors, const Eigen::VectorXd& target,
-                                int level,
-                                RefinementStats& stats);
+                                int level, RefinementStats& stats,
+                                const RefinementProgress& progress = {});
 
 }  // namespace psq

@@ -432,6 +432,7 @@ TEST(JobStoreResults, LevelRecordsRoundTripAndLaterAttemptsReplaceThem) {
   coarse.residuals = {1.0, 1e-3, 1e-9};
   coarse.timings = {{"solve", 0.25}, {"checkpoint", 0.01}};
   coarse.static_residuals = {{2, 1e-6}, {3, 2.5e-7}};
+  coarse.refinement = {{"expansions", 12.0}, {"final_gap", 1.0 / 3.0}};
   coarse.checkpoint_path = ".psq/runs/job-0000/level-0.h5";
   coarse.checkpoint_checksum = "sha256:abc";
   store.record_level(first->lease, coarse);
@@ -461,6 +462,8 @@ TEST(JobStoreResults, LevelRecordsRoundTripAndLaterAttemptsReplaceThem) {
   EXPECT_EQ(levels[0].residuals, coarse.residuals);
   EXPECT_EQ(levels[0].timings, coarse.timings);
   EXPECT_EQ(levels[0].static_residuals, coarse.static_residuals);
+  EXPECT_EQ(levels[0].refinement, coarse.refinement);
+  EXPECT_TRUE(levels[1].refinement.empty());
   EXPECT_EQ(levels[0].checkpoint_path, coarse.checkpoint_path);
   EXPECT_EQ(levels[0].checkpoint_checksum, coarse.checkpoint_checksum);
   EXPECT_EQ(levels[0].attempt, 1);  // written by the first attempt, kept

@@ -105,7 +105,7 @@ TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
     SqliteConnection raw(path, 1000);
     raw.execute(
         "ALTER TABLE jobs DROP COLUMN progress_attempt; ALTER TABLE jobs DROP COLUMN stalls; "
-        "DELETE FROM schema_version WHERE version > 3");
+        "ALTER TABLE levels DROP COLUMN refinement; DELETE FROM schema_version WHERE version > 3");
     ASSERT_EQ(schema_version(raw), 3);
   }
   JobStore upgraded(path);
@@ -116,6 +116,9 @@ TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
                                 "('progress_attempt', 'stalls')"),
             2);
   EXPECT_EQ(single_integer(raw, "SELECT SUM(stalls) FROM jobs"), 0);
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM pragma_table_info('levels') WHERE name = "
+                                "'refinement'"),
+            1);
 }
 
 TEST(JobStoreSchema, FileThatIsNotADatabaseIsRefusedByName) {

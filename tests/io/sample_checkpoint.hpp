@@ -50,6 +50,7 @@ inline Checkpoint sample_checkpoint(int k, int level, int frame) {
     c.statistics.iterations.push_back({frame - it / 4, it % 4, -1.0 / (it + 3), std::pow(0.1, it),
                                        std::pow(0.2, it), it % 3 == 0 ? 0.5 : 1.0, 0.01 * it});
   c.statistics.timings = {{"assembly", 0.125}, {"factorization", 0.375}, {"wall", 1.0 / 3.0}};
+  c.statistics.refinement = {{"expansions", 12.0}, {"final_gap", 1.0 / 7.0}, {"seconds", 0.25}};
   return c;
 }
 
@@ -74,6 +75,7 @@ inline void expect_same_checkpoint(const Checkpoint& actual, const Checkpoint& e
   EXPECT_EQ(actual.solver.scalars, expected.solver.scalars);
   EXPECT_EQ(actual.statistics.iterations, expected.statistics.iterations);
   EXPECT_EQ(actual.statistics.timings, expected.statistics.timings);
+  EXPECT_EQ(actual.statistics.refinement, expected.statistics.refinement);
 }
 
 }  // namespace psq::test

@@ -71,7 +71,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     record.elastic_energy = x_.squaredNorm();  // any function of the result will do
     return record;
   }
-  void refine() override {
+  void refine(const RefinementPhase&) override {
     ++level_;
     frame_ = 0;
   }

@@ -17,38 +17,10 @@
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "progressive/reference_runs.hpp"
+#include "support/press_scene.hpp"
 
 namespace psq {
 namespace {
-
-/// A sheet held at its rim, pressed by a descending sphere (bunny_press with a sphere): the
-/// frames are equilibria, and the pressed shape is unique up to the barrier's band: two solves
-/// whose κ differ rest at gaps anywhere within d̂, so d̂ (0.27e-3 of the diagonal) is kept
-/// below the 1e-3 of the diagonal by which the progressive and direct answers must agree.
-constexpr const char* kPress = R"(
-name = "press"
-gravity = [0, 0, -9.81]
-[time]
-step = 0.04
-frames = 10
-[contact]
-activation_distance = 2e-4
-[[shell]]
-name = "sheet"
-mesh = { generator = "sheet", width = 0.5, height = 0.5, edge_length = 0.04 }
-material = { youngs_modulus = 1e7, poisson_ratio = 0.4, density = 1000, thickness = 1e-3 }
-[[shell.pin]]
-name = "rim"
-boundary_loop = 0
-[[collider]]
-name = "ball"
-mesh = { generator = "sphere", radius = 0.1, edge_length = 0.03 }
-placement = { translation = [0, 0, 0.1011] }
-[[collider.motion]]
-start = 0.0
-end = 0.4
-translation = [0, 0, -0.06]
-)";
 
 /// drape_sphere at a CI size: cloth falling onto a sphere with friction.
 constexpr const char* kDrape = R"(
@@ -215,7 +187,7 @@ void expect_safe(const std::string& name, const ProgressiveRun& run, int levels)
 }
 
 TEST(ProgressiveContact, PressIsIntersectionFreeAtEveryLevelAndConverges) {
-  const ProgressiveRun run = run_checked(scene_from(kPress, "press"), 3);
+  const ProgressiveRun run = run_checked(scene_from(test::kPressScene, "press"), 3);
   expect_safe("press", run, 3);
   EXPECT_TRUE(run.converged);
 }
@@ -244,7 +216,7 @@ TEST(ProgressiveContact, CrushIsIntersectionFreeAtEveryLevelAndConverges) {
 TEST(ProgressiveContact, PressMatchesTheDirectFineEquilibrium) {
   // The pressed sheet's equilibrium is unique: the progressive finest answer and a direct solve
   // of the same frames must agree within 1e-3 of the bounding-box diagonal.
-  const Scene scene = scene_from(kPress, "press");
+  const Scene scene = scene_from(test::kPressScene, "press");
   const ProgressiveRun progressive = run_checked(scene, 2);
   QuasistaticSimulation direct(scene);
   bool converged = true;
@@ -261,7 +233,7 @@ TEST(ProgressiveContact, ResumingBetweenStepsEndsExactlyLikeTheUninterruptedRun)
   // κ travels with the schedule state, and the safe initialization is deterministic (its random
   // retries are seeded), so a run restored between any two steps, before a refinement included,
   // ends bit-exactly where the uninterrupted one does.
-  const Scene scene = scene_from(kPress, "press");
+  const Scene scene = scene_from(test::kPressScene, "press");
   ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
   settings.schedule.levels = 2;
   struct Stored {
@@ -298,7 +270,7 @@ TEST(ProgressiveContact, ResumingBetweenStepsEndsExactlyLikeTheUninterruptedRun)
 }
 
 TEST(ProgressiveContact, AnIntersectingRestStateIsRefusedNamingTheTriangles) {
-  std::string text = kPress;
+  std::string text = test::kPressScene;
   // The ball starts through the sheet.
   text.replace(text.find("0.1011]"), 7, "0.05]  ");
   try {
