@@ -90,6 +90,7 @@ class ProgressiveLevelSolver final : public LevelSolver {
             .step_norm = newton.step_norm,
             .gradient_norm = newton.gradient_norm,
             .elastic_energy = step.frame.elastic_energy,
+            .failure = step.settling_failure,
             .times = newton.times};
   }
   void refine(const RefinementPhase& phase) override { simulation_.refine(phase); }

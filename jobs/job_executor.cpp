@@ -270,6 +270,8 @@ class JobRun {
             "level {} frame {} stagnated at round-off at ‖Δx‖∞/Δt = {:.3e}: solver.tolerance is "
             "finer than double precision resolves for this scene; raise it above that",
             frame.level, frame.frame, frame.step_norm));
+      if (frame.must_converge && !frame.converged && !frame.failure.empty())
+        throw NotConverged(frame.failure);
       if (frame.must_converge && !frame.converged)
         throw NotConverged(fmt::format(
             "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "

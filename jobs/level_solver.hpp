@@ -26,6 +26,9 @@ struct LevelFrame {
   double step_norm = 0.0;       ///< final ‖d‖∞ / Δt
   double gradient_norm = 0.0;   ///< final ‖∇E‖
   double elastic_energy = 0.0;  ///< of the frame's result, at the finest scale (J)
+  /// Why a frame that had to converge did not, when the solver knows better than "its Newton
+  /// budget ran out" (a settling that stalled); empty otherwise.
+  std::string failure;
   PhaseTimes times;             ///< of this step() call
 };
 

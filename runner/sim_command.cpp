@@ -54,13 +54,16 @@ struct LevelRecord {
   int iterations = 0;
   double seconds = 0.0;
   bool converged = true;
+  std::string settling_failure;  ///< why a settling of the level stopped without an equilibrium
   nlohmann::json steps = nlohmann::json::array();
 
   [[nodiscard]] nlohmann::json json() const {
-    return {{"level", level},         {"vertices", vertices},
-            {"triangles", triangles}, {"iterations", iterations},
-            {"seconds", seconds},     {"converged", converged},
-            {"steps", steps}};
+    nlohmann::json out{{"level", level},         {"vertices", vertices},
+                       {"triangles", triangles}, {"iterations", iterations},
+                       {"seconds", seconds},     {"converged", converged},
+                       {"steps", steps}};
+    if (!settling_failure.empty()) out["settling_failure"] = settling_failure;
+    return out;
   }
 };
 
@@ -209,6 +212,10 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
           sim.frame_count(), step.settling ? " (settling)" : "", step.frame.newton.iterations,
           verdict(step.frame.newton), step.change,
           step.frame.newton.wall_seconds);
+      if (!step.settling_failure.empty()) {
+        level.settling_failure = step.settling_failure;
+        std::cerr << "  " << step.settling_failure << "\n";
+      }
     }
     if (sim.level_count() > 1) level.converged = level.converged && sim.level_converged();
     all_converged = all_converged && level.converged;

@@ -303,7 +303,10 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     settle_growth_ = next_settling_growth(settle_growth_, converged_at_start);
     settled_ = done || settle_steps_ >= settings_.max_settle_steps ||
                stalled_steps_ >= kMaxStalledSettleSteps;
-    if (settled_ && !done) settling_failed_ = true;
+    if (settled_ && !done) {
+      settling_failed_ = true;
+      out.settling_failure = settling_failure_message(out.change);
+    }
     out.equilibrium = done;
     if (done) out.frame.static_residual = out.frame.newton.step_norm;
     out.judged = finest_level() && settled_;
@@ -319,6 +322,22 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     out.converged = out.frame.newton.converged;
   }
   return out;
+}
+
+std::string ProgressiveSimulation::settling_failure_message(double change) const {
+  if (stalled_steps_ >= kMaxStalledSettleSteps)
+    return fmt::format(
+        "level {} frame {}: the settling to a static equilibrium stalled: over {} steps at the "
+        "largest pseudo time step (Δt·4^{}) the change ‖x − xᵗ‖∞/Δt did not fall below {:.3e} "
+        "m/s (last {:.3e} m/s, tolerance {:.3g} m/s). A structure that keeps moving at that "
+        "step is not held against its loads: check that its pins, colliders and friction "
+        "support it",
+        level_, frame_, kMaxStalledSettleSteps, kSettlingGrowthSteps, best_change_, change,
+        tolerance());
+  return fmt::format(
+      "level {} frame {}: the settling to a static equilibrium stopped after {} steps with the "
+      "change ‖x − xᵗ‖∞/Δt at {:.3e} m/s (tolerance {:.3g} m/s)",
+      level_, frame_, settle_steps_, change, tolerance());
 }
 
 void ProgressiveSimulation::refine(const RefinementProgress& progress) {

@@ -68,6 +68,9 @@ struct ProgressiveStep {
   bool judged = false;
   /// The verdict: Newton converged and, for a settling step, the equilibrium was reached.
   bool converged = false;
+  /// On the step that ends a settling without an equilibrium: why it stopped and what to change
+  /// (empty otherwise).
+  std::string settling_failure;
   /// Frame, time, fine-scale elastic energy (Ψ_L(P^l(x))), Newton history and timings.
   FrameRecord frame;
 };
@@ -174,6 +177,9 @@ class ProgressiveSimulation {
   void enter_level(int level);
   [[nodiscard]] NewtonSettings level_newton_settings(int level) const;
   [[nodiscard]] bool settles() const { return level_count_ > 1; }
+  /// Why the settling that just ended did not reach an equilibrium, for a step whose change
+  /// was `change`.
+  [[nodiscard]] std::string settling_failure_message(double change) const;
 
   ProgressiveSettings settings_;
   ShellSystem finest_;

@@ -66,6 +66,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     record.level = level_;
     record.frame = frame;
     record.converged = !(level_ == fail_at_level && frame == fail_at_frame);
+    if (!record.converged) record.failure = failure;
     record.must_converge = level_ + 1 == levels_;  // coarser levels are previews
     record.iterations = iterations_;
     record.elastic_energy = x_.squaredNorm();  // any function of the result will do
@@ -95,6 +96,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
   }
 
   int fail_at_level = -1, fail_at_frame = -1;  ///< the frame that does not converge
+  std::string failure;                          ///< the reason it gives, if any
 
  private:
   int levels_, frames_, iterations_;
@@ -136,6 +138,7 @@ class Workspace {
           auto solver = std::make_unique<ScriptedSolver>(depth, kFrames, kIterations);
           solver->fail_at_level = fail_at_level;
           solver->fail_at_frame = fail_at_frame;
+          solver->failure = failure;
           return solver;
         },
         {.snapshot_iterations = 2, .snapshot_seconds = 1e9, .code_version = "test"}, events, stop);
@@ -153,6 +156,7 @@ class Workspace {
   std::atomic<bool> stop{false};
   std::string log;
   int fail_at_level = -1, fail_at_frame = -1;
+  std::string failure;
   double lease_seconds = 30.0;
 
  private:
@@ -298,6 +302,17 @@ TEST_F(Executor, AFinestFrameThatDoesNotConvergeFailsTheJobForGood) {
   ASSERT_EQ(r.levels.size(), 2u);
   EXPECT_EQ(r.levels[0].status, db::LevelStatus::done);
   EXPECT_EQ(r.levels[1].status, db::LevelStatus::failed);
+}
+
+TEST_F(Executor, AFrameThatFailsForAReasonItKnowsFailsTheJobWithThatReason) {
+  fail_at_level = 1;
+  fail_at_frame = 2;
+  failure = "level 1 frame 2: the settling to a static equilibrium stalled";
+  ASSERT_EQ(run(), jobs::RunOutcome::failed);
+  const db::JobResult r = result();
+  EXPECT_EQ(r.job.state, db::JobState::failed);
+  EXPECT_NE(r.job.error.find(failure), std::string::npos) << r.job.error;
+  EXPECT_EQ(r.job.error.find("max_iterations"), std::string::npos) << r.job.error;
 }
 
 TEST_F(Executor, APreviewFrameMayStopAtItsIterationBudget) {

@@ -4,12 +4,14 @@
 
 #include "engine/progressive/progressive_simulation.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <iostream>
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/core/error.hpp"
 #include "engine/scene/scene_reader.hpp"
@@ -185,6 +187,50 @@ TEST(ProgressiveSimulation, ScheduleStepsPreviewFramesThenSettlesThenRefines) {
   run_level(sim);
   EXPECT_TRUE(sim.finished());
   EXPECT_EQ(sim.frame(), 4);
+}
+
+TEST(ProgressiveSimulation, ASettlingWithoutAnEquilibriumStopsAndSaysWhy) {
+  // An unpinned sheet under gravity has no static equilibrium: at the largest pseudo time step
+  // every settling step moves it by g·(Δt·4⁶)² again, and the change never falls.
+  const Scene scene = read_scene_text(R"(
+name = "falling"
+gravity = [0, 0, -9.81]
+[time]
+step = 0.04
+frames = 2
+[[shell]]
+name = "sheet"
+mesh = { generator = "sheet", width = 0.2, height = 0.2, edge_length = 0.04 }
+material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 1000, thickness = 1e-3 }
+)",
+                                      "falling.toml");
+  ProgressiveSimulation sim(scene, two_levels(scene));
+  ProgressiveStep last;
+  std::vector<std::string> failures;
+  for (;;) {
+    while (!sim.level_done()) {
+      last = sim.step();
+      if (!last.settling_failure.empty()) failures.push_back(last.settling_failure);
+    }
+    if (sim.finished()) break;
+    sim.refine();
+  }
+  EXPECT_TRUE(last.judged);
+  EXPECT_FALSE(last.converged);
+  EXPECT_FALSE(sim.level_converged());
+  // The preview's settling and the finest level's each end with their reason, once.
+  ASSERT_EQ(failures.size(), 2u);
+  EXPECT_EQ(failures.back(), last.settling_failure);
+  for (int level = 0; level < 2; ++level) {
+    const std::string& message = failures[static_cast<std::size_t>(level)];
+    EXPECT_NE(message.find(fmt::format(
+                  "level {} frame 2: the settling to a static equilibrium stalled", level)),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("check that its pins, colliders and friction support it"),
+              std::string::npos)
+        << message;
+  }
 }
 
 TEST(ProgressiveSimulation, RestoreResumesWhereTheStoredStateLeftOff) {
