@@ -21,6 +21,9 @@ constexpr double kCorrectionTarget = 0.2;
 /// The correction is needed, and done, when some triangle is (still) above s̄ − kCorrectionSlack·δ:
 /// the level's barrier then starts with at least a tenth of its band as slack.
 constexpr double kCorrectionSlack = 0.1;
+/// A correction that cannot reach s̄ − kCorrectionSlack·δ is still taken when every triangle is
+/// below s̄ − kFeasibleSlack·δ: the level's barrier is finite there and its solve takes over.
+constexpr double kFeasibleSlack = 1e-3;
 /// ρ of the proximity term. V's Gauss–Newton curvature 2Ā|β|² is of order one at any scale
 /// (Ā ∝ ℓ², |β| ∝ 1/ℓ), so a fixed ρ four orders below it keeps the Hessian definite without
 /// holding the vertices back.
@@ -28,9 +31,12 @@ constexpr double kProximityWeight = 1e-4;
 /// Newton iterations between two feasibility checks, and the budget of one solve.
 constexpr int kCheckEvery = 5;
 constexpr int kMaxIterations = 100;
-/// A solve ends early when its last kCheckEvery iterations took less than this fraction of the
-/// tightest triangle's remaining excess off: the vertices it moves cannot restore the limit.
+/// A solve ends early when its best state has not improved by this fraction of the tightest
+/// triangle's remaining excess over kStalledChecks checks in a row: the vertices it moves cannot
+/// restore the limit. The tightest triangle is a maximum over a sum Newton minimizes, so one
+/// check may be worse than the one before while the sum still falls.
 constexpr double kLeastProgress = 0.01;
+constexpr int kStalledChecks = 3;
 /// Newton's step tolerance, relative to the bounding-box diagonal: the correction needs the
 /// stretches below their accepted bound, not the minimizer of V to many digits.
 constexpr double kCorrectionTolerance = 1e-6;
@@ -124,16 +130,20 @@ double StretchExcess::max_feasible_step(const Eigen::VectorXd& x, const Eigen::V
 
 StretchExcess::Tightest StretchExcess::tightest(const Eigen::VectorXd& x) const {
   Tightest tightest;
+  bool feasible = true;
   double worst = -std::numeric_limits<double>::infinity();
   for (const LimitedShell& shell : shells_)
     for (std::size_t t = 0; t < shell.triangles.size(); ++t) {
       const double sigma =
           largest_stretch(shell.triangles.positions(x, t), shell.triangles.rest(t)).sigma;
+      const double slack = (shell.limit - shell.accepted) * (kFeasibleSlack / kCorrectionSlack);
+      feasible = feasible && sigma <= shell.limit - slack;
       if (sigma - shell.accepted > worst) {
         worst = sigma - shell.accepted;
         tightest = {shell.name, shell.limit, shell.accepted, sigma, sigma <= shell.accepted};
       }
     }
+  tightest.feasible = feasible;
   return tightest;
 }
 
@@ -160,26 +170,34 @@ StrainCorrectionStats correct_strain_limits(const ShellSystem& fine,
   NewtonSettings settings;
   settings.max_iterations = kCheckEvery;
   settings.tolerance = kCorrectionTolerance * bounding_box_diagonal(fine.rest_mesh().vertices);
-  // One solve over the free DOFs of `dofs`; returns the tightest triangle it ends with.
+  // One solve over the free DOFs of `dofs`; x ends at the best state it passed (the least
+  // tightest excess), which it returns.
   const auto solve = [&](const DofMap& dofs) {
-    StretchExcess::Tightest now = excess.tightest(x);
-    if (dofs.free_size() == 0) return now;
+    StretchExcess::Tightest best = excess.tightest(x);
+    if (dofs.free_size() == 0) return best;
     if (contact) {
       Eigen::VectorXd g;
       excess.excess_gradient(x, g);
       balance_barrier_stiffness(*contact, x, g, dofs);
     }
+    Eigen::VectorXd best_x = x;
+    int stalled = 0;
     for (int done = 0; done < kMaxIterations; done += kCheckEvery) {
-      const double sigma = now.sigma;
       const NewtonResult result = newton.minimize(excess, x, dofs, settings);
       stats.iterations += result.iterations;
-      now = excess.tightest(x);
-      if (now.acceptable || result.converged || result.stagnated) break;
-      // The vertices this solve moves cannot take the tightest triangle back any further.
-      if (sigma - now.sigma < kLeastProgress * (sigma - now.accepted)) break;
+      const StretchExcess::Tightest now = excess.tightest(x);
+      const bool improved = now.excess() < best.excess() - kLeastProgress * best.excess();
+      stalled = improved ? 0 : stalled + 1;
+      if (now.excess() < best.excess()) {
+        best = now;
+        best_x = x;
+      }
+      if (best.acceptable || result.converged || result.stagnated || stalled == kStalledChecks)
+        break;
       if (contact) contact->update_stiffness(x, false);
     }
-    return now;
+    x = best_x;
+    return best;
   };
   StretchExcess::Tightest end = solve(movable_vertex_dofs(fine, inserted));
   if (!end.acceptable) {
@@ -189,7 +207,7 @@ StrainCorrectionStats correct_strain_limits(const ShellSystem& fine,
   stats.stretch_after = end.sigma / end.limit;
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (!end.acceptable)
+  if (!end.feasible)
     throw NumericalError(fmt::format(
         "refinement into level {}: shell '{}' keeps a principal stretch of {:.6g} after the "
         "strain-limit correction (its strain_limit is {:.6g}); use fewer [hierarchy] levels or "

@@ -13,7 +13,12 @@
 // contact, the scene's barrier is added (κ from IPC's balance with V's gradient) and each step is
 // cut by the contact CCD, so the correction never introduces an intersection. Where the new
 // vertices alone cannot restore the limit (a triangle of old vertices only), every unpinned
-// vertex is freed for a second solve.
+// vertex is freed for a second solve. Each solve ends at the best state it passed (the tightest
+// triangle is a maximum, which a step that lowers the sum may raise) and stops once that best
+// state stops improving. A correction that ends short of s̄ − kCorrectionSlack·δ is still taken
+// when every triangle is below s̄ − kFeasibleSlack·δ: strictly within the limit, the level's
+// barrier is finite there and its solve takes over (the contact barrier pushing a sheet onto a
+// sphere can hold the correction a few per mille of δ above the first bound).
 
 #include <Eigen/Core>
 #include <string>
@@ -38,6 +43,12 @@ class StretchExcess final : public Objective {
     double accepted = 0.0;  ///< s̄ − kCorrectionSlack·δ of the shell
     double sigma = 0.0;     ///< σ₁ of the triangle
     bool acceptable = true; ///< σ₁ ≤ s̄ − kCorrectionSlack·δ for every limited triangle
+    /// σ₁ ≤ s̄ − kFeasibleSlack·δ for every limited triangle: strictly within the limits, the
+    /// barrier finite, with less room than `acceptable` gives it.
+    bool feasible = true;
+    /// How far the tightest triangle is above its accepted bound (σ₁ − (s̄ − kCorrectionSlack·δ)):
+    /// the measure a correction reduces.
+    [[nodiscard]] double excess() const { return sigma - accepted; }
   };
 
   /// `contact` may be null (no barrier, no CCD) and must outlive this objective.
