@@ -42,7 +42,8 @@ struct Axis {
 /// Reads a sweep file's TOML and raises located InputErrors about it.
 class SweepReader {
  public:
-  explicit SweepReader(fs::path file) : file_(std::move(file)), document_(parse()) {}
+  SweepReader(std::string_view text, fs::path file)
+      : file_(std::move(file)), document_(parse(text)) {}
 
   Sweep read() {
     allow_only(document_, {"name", "scene", kDepth, "grid", "zip"}, "at the top level");
@@ -71,13 +72,9 @@ class SweepReader {
     throw InputError(located_message(file_.string(), line, message));
   }
 
-  toml::table parse() const {
-    std::ifstream in(file_, std::ios::binary);
-    if (!in) fail(0, "cannot open the sweep file");
-    std::stringstream text;
-    text << in.rdbuf();
+  toml::table parse(std::string_view text) const {
     try {
-      return toml::parse(text.str(), file_.string());
+      return toml::parse(text, file_.string());
     } catch (const toml::parse_error& error) {
       fail(line_of_error(error), fmt::format("TOML syntax error: {}", error.description()));
     }
@@ -273,7 +270,18 @@ class SweepReader {
 
 }  // namespace
 
-Sweep read_sweep(const fs::path& file) { return SweepReader(fs::absolute(file)).read(); }
+Sweep read_sweep(const fs::path& file) {
+  const fs::path absolute = fs::absolute(file);
+  std::ifstream in(absolute, std::ios::binary);
+  if (!in) throw InputError(located_message(absolute.string(), 0, "cannot open the sweep file"));
+  std::stringstream text;
+  text << in.rdbuf();
+  return read_sweep_text(text.str(), absolute);
+}
+
+Sweep read_sweep_text(std::string_view text, const fs::path& file) {
+  return SweepReader(text, fs::absolute(file)).read();
+}
 
 std::string describe_parameters(const SweepJob& job) {
   std::string text = fmt::format("depth={}", job.depth);

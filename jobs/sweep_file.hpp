@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "db/job_records.hpp"
@@ -42,6 +43,11 @@ struct Sweep {
 /// twice, two jobs with the same parameters, and impossible values (reported at the value's
 /// line with the first job that has it, e.g. negative thickness, ν ≥ 0.5, depth 0).
 Sweep read_sweep(const std::filesystem::path& file);
+
+/// read_sweep on `text` as if it were the content of the sweep file `file` (which need not
+/// exist): messages name `file` and the scene is resolved relative to its directory. For
+/// callers that hold the text already, such as the fuzz target.
+Sweep read_sweep_text(std::string_view text, const std::filesystem::path& file);
 
 /// "depth=1 shell.cloth.material.thickness=0.0005 ...": a job's parameters on one line, paths
 /// sorted.

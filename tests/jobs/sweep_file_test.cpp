@@ -253,5 +253,25 @@ TEST(SweepFile, TheDemoSweepExpandsToEightValidJobsAtTwoDepths) {
             (test::source_dir() / "jobs/scenes/demo_strip.toml").lexically_normal().string());
 }
 
+TEST(SweepFile, TextIsReadAsIfItWereTheNamedFile) {
+  const auto dir = sweep_dir();
+  const std::string body = "[grid]\n\"" + kH + "\" = [1e-3, 2e-3]\n";
+  const auto from_file = read_sweep(write_sweep(dir, body));
+  const auto from_text = jobs::read_sweep_text(
+      "name = \"s\"\nscene = \"scene.toml\"\n" + body, dir / "unwritten.toml");
+  EXPECT_EQ(from_text.file, dir / "unwritten.toml");
+  EXPECT_EQ(from_text.scene, from_file.scene);
+  ASSERT_EQ(from_text.jobs.size(), 2u);
+  EXPECT_EQ(from_text.jobs[1].id, from_file.jobs[1].id);
+  try {
+    jobs::read_sweep_text("name = 1\n", dir / "unwritten.toml");
+    ADD_FAILURE() << "a bad name was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find((dir / "unwritten.toml").string() + ":1:"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace psq
