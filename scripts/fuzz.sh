@@ -11,16 +11,18 @@ limit=(-max_total_time="${FUZZ_SECONDS:-25}")
 [ -z "${FUZZ_RUNS:-}" ] || limit=(-runs="$FUZZ_RUNS")
 cmake -S . -B build-fuzz -DPSQ_FUZZ=ON -DPSQ_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ >/dev/null
-targets=(obj off ply scene)
+targets=(obj off ply scene sweep)
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
 
-# Seeds: the hand-written meshes of tests/fuzz/corpus and the library's scenes and meshes.
+# Seeds: the hand-written meshes and sweeps of tests/fuzz/corpus and the library's scenes,
+# sweeps and meshes.
 # New inputs go into build-fuzz/corpus/<target>, the first (writable) corpus directory.
 declare -A seeds=(
   [obj]="tests/fuzz/corpus/obj jobs/data"
   [off]="tests/fuzz/corpus/off"
   [ply]="tests/fuzz/corpus/ply"
   [scene]="jobs/scenes"
+  [sweep]="tests/fuzz/corpus/sweep jobs/sweeps"
 )
 mkdir -p build-fuzz/findings
 for target in "${targets[@]}"; do
