@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <system_error>
 
 #include "engine/core/error.hpp"
 #include "engine/scene/key_suggestion.hpp"
@@ -112,9 +113,12 @@ class SweepReader {
   /// The base scene, relative to the sweep file's directory.
   fs::path scene_path() const {
     const fs::path scene = (file_.parent_path() / required_string("scene")).lexically_normal();
-    if (!fs::is_regular_file(scene))
+    // Without the error code, a name the OS refuses (e.g. too long) would throw filesystem_error.
+    std::error_code error;
+    if (!fs::is_regular_file(scene, error))
       fail(line_of(*document_.get("scene")),
-           fmt::format("scene file '{}' does not exist", scene.string()));
+           error ? fmt::format("scene file '{}': {}", scene.string(), error.message())
+                 : fmt::format("scene file '{}' does not exist", scene.string()));
     return scene;
   }
 

@@ -234,6 +234,15 @@ TEST(SweepFile, MissingSceneAndMissingNameAreRefused) {
   EXPECT_NE(error_of(dir / "absent.toml").find("cannot open the sweep file"), std::string::npos);
 }
 
+TEST(SweepFile, SceneFileNameTooLongIsAnInputErrorAtItsLine) {
+  const auto dir = sweep_dir();
+  const auto file = test::write_file(
+      dir / "long.toml", "name = \"s\"\nscene = \"" + std::string(300, 'a') + ".toml\"\n");
+  EXPECT_NE(error_of(file).find(file.string() + ":2: scene file"), std::string::npos)
+      << error_of(file);
+  EXPECT_NE(error_of(file).find("too long"), std::string::npos) << error_of(file);
+}
+
 TEST(SweepFile, AnInvalidSceneIsReportedInTheSceneFile) {
   const auto dir = sweep_dir();
   test::write_file(dir / "scene.toml", "name = \"x\"\n[time]\nstep = -1\n[[shell]]\n");
