@@ -24,6 +24,11 @@ namespace fs = std::filesystem;
 
 const std::string kDepth = "depth";
 
+/// Far more jobs than a sweep is run with; a larger product of the axes is almost surely a
+/// mistake (a long list in a [grid] meant for a [[zip]]), and expanding and validating it one
+/// job at a time would hang the reader before it reports anything.
+constexpr std::size_t kMaxJobs = 10'000;
+
 long line_of(const toml::node& node) { return static_cast<long>(node.source().begin.line); }
 
 /// A value as written in the sweep file, with its line.
@@ -55,6 +60,7 @@ class SweepReader {
     sweep.scene_hash = file_content_hash(sweep.scene);
     const Scene base = read_scene(sweep.scene);
     const std::vector<Axis> axes = read_axes(base);
+    check_job_count(axes);
     const Value depth = default_depth(axes);
     std::map<std::string, std::size_t> index_of_id;
     for_each_combination(axes, [&](const std::vector<std::size_t>& pick) {
@@ -205,6 +211,16 @@ class SweepReader {
       }
     }
     return axes;
+  }
+
+  void check_job_count(const std::vector<Axis>& axes) const {
+    // In floating point, as the product of a few hundred-value axes overflows std::size_t.
+    double count = 1;
+    for (const Axis& axis : axes) count *= static_cast<double>(axis.size());
+    if (count > kMaxJobs)
+      fail(0, fmt::format("the sweep expands to {:.0f} jobs, more than the {} a sweep may hold; "
+                          "split it into several sweeps or zip lists that vary together",
+                          count, kMaxJobs));
   }
 
   /// The depth of jobs whose axes do not vary it: the top-level `depth`, 1 if absent.

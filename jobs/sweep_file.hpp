@@ -40,8 +40,9 @@ struct Sweep {
 /// nearest valid key), a missing name or scene, a scene file that does not exist or is
 /// invalid (reported in the scene file), unknown parameter paths (with the nearest valid
 /// path), lists that are empty or not lists, zipped lists of different lengths, a path varied
-/// twice, two jobs with the same parameters, and impossible values (reported at the value's
-/// line with the first job that has it, e.g. negative thickness, ν ≥ 0.5, depth 0).
+/// twice, two jobs with the same parameters, more than 10 000 jobs, and impossible values
+/// (reported at the value's line with the first job that has it, e.g. negative thickness,
+/// ν ≥ 0.5, depth 0).
 Sweep read_sweep(const std::filesystem::path& file);
 
 /// read_sweep on `text` as if it were the content of the sweep file `file` (which need not

@@ -243,6 +243,26 @@ TEST(SweepFile, SceneFileNameTooLongIsAnInputErrorAtItsLine) {
   EXPECT_NE(error_of(file).find("too long"), std::string::npos) << error_of(file);
 }
 
+TEST(SweepFile, MoreThanTenThousandJobsAreRefusedBeforeExpansion) {
+  const auto dir = sweep_dir();
+  auto list = [](int count) {
+    std::string text = "[1";
+    for (int i = 2; i <= count; ++i) text += ", " + std::to_string(i);
+    return text + "]";
+  };
+  // 400 × 300 × 64 = 7 680 000 jobs: refused at once, not after expanding them.
+  const auto file = write_sweep(dir, "[grid]\n\"time.frames\" = " + list(400) +
+                                         "\n\"solver.max_iterations\" = " + list(300) +
+                                         "\ndepth = " + list(64) + "\n");
+  EXPECT_NE(error_of(file).find("expands to 7680000 jobs, more than the 10000"),
+            std::string::npos)
+      << error_of(file);
+  EXPECT_EQ(read_sweep(write_sweep(dir, "[grid]\n\"time.frames\" = " + list(100) +
+                                            "\n\"solver.max_iterations\" = " + list(100) + "\n"))
+                .jobs.size(),
+            10'000u);
+}
+
 TEST(SweepFile, AnInvalidSceneIsReportedInTheSceneFile) {
   const auto dir = sweep_dir();
   test::write_file(dir / "scene.toml", "name = \"x\"\n[time]\nstep = -1\n[[shell]]\n");
