@@ -120,6 +120,8 @@ class Reader {
       failed_ = true;
       return;
     }
+    // An empty array's data() may be null, and memcpy takes no null pointer even for 0 bytes.
+    if (size == 0) return;
     std::memcpy(out, in_.data() + at_, size);
     at_ += size;
   }
