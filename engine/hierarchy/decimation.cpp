@@ -573,6 +573,7 @@ MeshHierarchy build_hierarchy(const TriMesh& finest, const std::vector<int>& pin
     const int target = static_cast<int>(std::lround(settings.vertex_ratio * finer_count));
     decimator.decimate_to(target);
     if (decimator.vertex_count() == finer_count) {
+      if (settings.allow_fewer_levels) break;
       throw InputError(fmt::format(
           "hierarchy: level {} would equal level {} ({} vertices): no edge can be collapsed "
           "under the boundary, pin and quality rules; use fewer levels",

@@ -228,6 +228,7 @@ std::uint64_t hierarchy_cache_key(const TriMesh& finest, const std::vector<int>&
       .value(kHierarchyCornerDegrees)
       .value(settings.levels)
       .value(settings.vertex_ratio)
+      .value(settings.allow_fewer_levels)
       .value(static_cast<std::int64_t>(finest.vertex_count()))
       .bytes(finest.vertices.data(), finest.vertices.size() * sizeof(double))
       .value(static_cast<std::int64_t>(finest.triangle_count()))

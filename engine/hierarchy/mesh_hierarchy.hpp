@@ -28,6 +28,10 @@ struct HierarchySettings {
   int levels = 3;
   /// Each coarser level keeps about this fraction of the vertices of the next finer one.
   double vertex_ratio = 0.25;
+  /// A level that no collapse can make coarser ends the hierarchy with fewer levels instead of
+  /// being an InputError: for collision objects, whose coarse levels only save work, while a
+  /// shell's levels are the schedule the user asked for.
+  bool allow_fewer_levels = false;
 };
 
 /// One level of the hierarchy.
@@ -81,7 +85,8 @@ inline constexpr double kHierarchyCornerDegrees = 40.0;
 /// would break the angle or normal bounds, or flip a triangle against the finest surface
 /// normals it covers, are refused. A level that cannot reach its target keeps the count it
 /// reached. Throws InputError for settings out of range, a pin_group of the wrong size, an
-/// invalid mesh, or a level that no collapse can make coarser than the next finer one.
+/// invalid mesh, or (unless settings.allow_fewer_levels) a level that no collapse can make
+/// coarser than the next finer one.
 MeshHierarchy build_hierarchy(const TriMesh& finest, const std::vector<int>& pin_group,
                               const HierarchySettings& settings);
 

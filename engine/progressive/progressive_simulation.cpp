@@ -88,7 +88,7 @@ ProgressiveSimulation::ProgressiveSimulation(const Scene& scene,
                                              const ProgressiveSettings& settings)
     : settings_(settings), finest_(scene) {
   check_settings(scene, settings_);
-  if (settings_.schedule.levels > 1) hierarchies_ = build_shell_hierarchies(finest_, settings_);
+  if (settings_.schedule.levels > 1) hierarchies_ = build_hierarchies(finest_, settings_);
   initialize();
 }
 
@@ -104,16 +104,21 @@ ProgressiveSimulation::~ProgressiveSimulation() = default;
 
 void ProgressiveSimulation::initialize() {
   const Scene& scene = finest_.scene();
-  if (!hierarchies_.empty() && hierarchies_.size() != finest_.shells().size())
-    throw std::invalid_argument(fmt::format("ProgressiveSimulation: {} hierarchies for {} shells",
-                                            hierarchies_.size(), finest_.shells().size()));
-  for (std::size_t s = 0; s < hierarchies_.size(); ++s) {
-    if (hierarchies_[s].levels.empty() ||
-        hierarchies_[s].finest().rest.vertex_count() != finest_.shells()[s].vertex_count)
+  const std::size_t shells = finest_.shells().size();
+  const std::size_t colliders = finest_.colliders().size();
+  if (!hierarchies_.empty() && hierarchies_.size() != shells &&
+      hierarchies_.size() != shells + colliders)
+    throw std::invalid_argument(fmt::format(
+        "ProgressiveSimulation: {} hierarchies for {} shells and {} colliders",
+        hierarchies_.size(), shells, colliders));
+  for (std::size_t k = 0; k < hierarchies_.size(); ++k) {
+    const MeshBlock& block = k < shells ? finest_.shells()[k] : finest_.colliders()[k - shells];
+    if (hierarchies_[k].levels.empty() ||
+        hierarchies_[k].finest().rest.vertex_count() != block.vertex_count)
       throw std::invalid_argument(fmt::format(
-          "ProgressiveSimulation: the hierarchy of shell '{}' does not end at the shell's mesh",
-          finest_.shells()[s].name));
-    level_count_ = std::max(level_count_, hierarchies_[s].level_count());
+          "ProgressiveSimulation: the hierarchy of {} '{}' does not end at its mesh",
+          k < shells ? "shell" : "collider", block.name));
+    if (k < shells) level_count_ = std::max(level_count_, hierarchies_[k].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
   finest_tolerance_ =
@@ -124,13 +129,13 @@ void ProgressiveSimulation::initialize() {
   if (contact_enabled(scene)) {
     require_intersection_free(finest_.rest_mesh(), "the rest state", triangle_parts(finest_));
     for (int level = level_count_ - 2; level >= 0; --level) {
-      const ShellSystem system(scene, level_shells(level));
+      const std::unique_ptr<ShellSystem> system = make_coarse_system(level);
       require_intersection_free(
-          system.rest_mesh(),
+          system->rest_mesh(),
           fmt::format("level {} of {} of the hierarchy (decimated rest state; use fewer "
                       "[hierarchy] levels or a larger vertex_ratio)",
                       level, level_count_),
-          triangle_parts(system));
+          triangle_parts(*system));
     }
   }
   enter_level(0);
@@ -154,9 +159,9 @@ void ProgressiveSimulation::build_prolongations() {
                                                            h.levels[next].rest.vertices));
     }
     const int collider_vertices =
-        finest_.rest_mesh().vertex_count() -
-        (finest_.colliders().empty() ? finest_.rest_mesh().vertex_count()
-                                     : finest_.colliders().front().first_vertex);
+        colliders_progressive() || finest_.colliders().empty()
+            ? 0
+            : finest_.rest_mesh().vertex_count() - finest_.colliders().front().first_vertex;
     to_finest_.emplace_back(std::move(finest_maps), collider_vertices);
     to_next_.emplace_back(std::move(next_maps), collider_vertices);
   }
@@ -176,9 +181,9 @@ ProgressiveSimulation::Expansion ProgressiveSimulation::system_expansion(int lev
          static_cast<int>(h.levels[here].expansion_color.size()) != coarse_count ||
          static_cast<int>(h.levels[here].collapses.size()) != fine_count - coarse_count))
       throw std::invalid_argument(fmt::format(
-          "ProgressiveSimulation: level {} of shell '{}' has no parents, expansion colours or "
+          "ProgressiveSimulation: level {} of '{}' has no parents, expansion colours or "
           "collapses for the safe refinement",
-          here, finest_.shells()[&h - hierarchies_.data()].name));
+          here, mesh_name(static_cast<int>(&h - hierarchies_.data()))));
     for (int v = 0; v < fine_count; ++v)
       expansion.parent.push_back(coarse_first + (next == here ? v : h.levels[here].parent[v]));
     if (next != here)
@@ -189,12 +194,12 @@ ProgressiveSimulation::Expansion ProgressiveSimulation::system_expansion(int lev
       expansion.color.push_back(next == here ? 0 : h.levels[here].expansion_color[k]);
     coarse_first += coarse_count;
   }
-  // Colliders keep their mesh at every level.
-  for (const ColliderBlock& collider : finest_.colliders())
-    for (int v = 0; v < collider.vertex_count; ++v) {
-      expansion.parent.push_back(coarse_first++);
-      expansion.color.push_back(0);
-    }
+  if (!colliders_progressive())  // the colliders keep their mesh at every level
+    for (const ColliderBlock& collider : finest_.colliders())
+      for (int v = 0; v < collider.vertex_count; ++v) {
+        expansion.parent.push_back(coarse_first++);
+        expansion.color.push_back(0);
+      }
   return expansion;
 }
 
@@ -214,11 +219,32 @@ NewtonSettings ProgressiveSimulation::level_newton_settings(int level) const {
 
 std::vector<LevelShellMesh> ProgressiveSimulation::level_shells(int level) const {
   std::vector<LevelShellMesh> shells;
-  for (const MeshHierarchy& h : hierarchies_) {
+  for (std::size_t s = 0; s < finest_.shells().size(); ++s) {
+    const MeshHierarchy& h = hierarchies_[s];
     const HierarchyLevel& shell = h.levels[shell_level(h, level, level_count_)];
     shells.push_back({shell.rest, shell.pin_group});
   }
   return shells;
+}
+
+std::vector<TriMesh> ProgressiveSimulation::level_colliders(int level) const {
+  std::vector<TriMesh> colliders;
+  if (colliders_progressive())
+    for (std::size_t k = finest_.shells().size(); k < hierarchies_.size(); ++k)
+      colliders.push_back(
+          hierarchies_[k].levels[shell_level(hierarchies_[k], level, level_count_)].rest);
+  return colliders;
+}
+
+std::unique_ptr<ShellSystem> ProgressiveSimulation::make_coarse_system(int level) const {
+  return std::make_unique<ShellSystem>(finest_.scene(), level_shells(level),
+                                       level_colliders(level));
+}
+
+std::string ProgressiveSimulation::mesh_name(int hierarchy) const {
+  const int shells = static_cast<int>(finest_.shells().size());
+  return hierarchy < shells ? finest_.shells()[hierarchy].name
+                            : finest_.colliders()[hierarchy - shells].name;
 }
 
 void ProgressiveSimulation::enter_level(int level) {
@@ -230,7 +256,7 @@ void ProgressiveSimulation::enter_level(int level) {
         finest_, std::make_unique<LevelObjective>(finest_, scene.time.step),
         level_newton_settings(level));
   } else {
-    coarse_system_ = std::make_unique<ShellSystem>(scene, level_shells(level));
+    coarse_system_ = make_coarse_system(level);
     stepper_ = std::make_unique<LevelStepper>(
         *coarse_system_,
         std::make_unique<ProxyObjective>(*coarse_system_, finest_, to_finest_[level],

@@ -50,10 +50,12 @@ struct ProgressiveSettings {
   static ProgressiveSettings from_scene(const Scene& scene);
 };
 
-/// One hierarchy per shell of `finest` (its meshes and pin groups), built with the schedule's
-/// levels and vertex ratio, through the cache in settings.cache_dir when that is set.
-std::vector<MeshHierarchy> build_shell_hierarchies(const ShellSystem& finest,
-                                                   const ProgressiveSettings& settings);
+/// One hierarchy per shell of `finest` (its meshes and pin groups), then one per collider
+/// (paper §4.6: collision objects are decimated, prolonged and coloured like shells), built
+/// with the schedule's levels and vertex ratio, through the cache in settings.cache_dir when
+/// that is set. A collider that cannot be decimated as far has fewer levels.
+std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
+                                             const ProgressiveSettings& settings);
 
 /// One step of a progressive solve.
 struct ProgressiveStep {
@@ -80,12 +82,14 @@ class ProgressiveSimulation {
   /// Called for every Newton iteration (level, frame, record).
   using Progress = std::function<void(int level, int frame, const NewtonIteration&)>;
 
-  /// Builds the finest system and, when settings.schedule.levels > 1, one hierarchy per shell
-  /// (pin groups from the shell's pinned sets; cached in settings.cache_dir when given).
+  /// Builds the finest system and, when settings.schedule.levels > 1, the hierarchies of its
+  /// shells and colliders (build_hierarchies).
   /// @throws InputError for invalid settings (naming the setting).
   ProgressiveSimulation(const Scene& scene, const ProgressiveSettings& settings);
-  /// The same with given hierarchies (one per shell, finest level = the shell's mesh). A shell
-  /// with fewer levels than the most refined one keeps its coarsest mesh at the lowest levels.
+  /// The same with given hierarchies: one per shell (finest level = the shell's mesh), then
+  /// either one per collider or none (the colliders keep their own mesh at every level). The
+  /// shells' hierarchies set the level count; a shell or collider with fewer levels keeps its
+  /// coarsest mesh at the lowest levels, one with more uses its finer levels only.
   ProgressiveSimulation(const Scene& scene, const ProgressiveSettings& settings,
                         std::vector<MeshHierarchy> hierarchies);
   ~ProgressiveSimulation();
@@ -173,6 +177,16 @@ class ProgressiveSimulation {
   [[nodiscard]] Expansion system_expansion(int level) const;
   /// The rest meshes and pin groups of the shells at system level `level` below the finest.
   [[nodiscard]] std::vector<LevelShellMesh> level_shells(int level) const;
+  /// The colliders' rest meshes at system level `level`; empty when they have no hierarchies.
+  [[nodiscard]] std::vector<TriMesh> level_colliders(int level) const;
+  /// The level-`level` system below the finest.
+  [[nodiscard]] std::unique_ptr<ShellSystem> make_coarse_system(int level) const;
+  /// The name of the shell or collider of hierarchies_[hierarchy].
+  [[nodiscard]] std::string mesh_name(int hierarchy) const;
+  /// Whether hierarchies_ holds the colliders' after the shells'.
+  [[nodiscard]] bool colliders_progressive() const {
+    return hierarchies_.size() > finest_.shells().size();
+  }
   /// Makes `level` the current level (its system, objective and stepper).
   void enter_level(int level);
   [[nodiscard]] NewtonSettings level_newton_settings(int level) const;
@@ -183,6 +197,7 @@ class ProgressiveSimulation {
 
   ProgressiveSettings settings_;
   ShellSystem finest_;
+  /// The shells' hierarchies, then the colliders' (if they have any).
   std::vector<MeshHierarchy> hierarchies_;
   int level_count_ = 1;
   int refine_frame_ = 1;

@@ -1,8 +1,9 @@
 #pragma once
 // Prolongation of a whole multi-shell system: the shells are concatenated into one vertex array
-// (ShellSystem), and each shell is prolonged by its own ShellProlongation on its blocks of the
-// coarse and target arrays. The colliders' vertices follow the shells' in both arrays (they keep
-// their mesh at every level) and are copied.
+// (ShellSystem), and each shell (and each collider with a hierarchy, paper §4.6) is prolonged by
+// its own ShellProlongation on its blocks of the coarse and target arrays. Colliders without
+// hierarchies keep their mesh at every level: their vertices follow in both arrays and are
+// copied.
 
 #include <Eigen/Core>
 #include <vector>
@@ -17,8 +18,8 @@ ShellProlongation identity_prolongation(const TriMesh& rest);
 
 class SystemProlongation {
  public:
-  /// One map per shell, in the shells' order in the concatenated arrays, then
-  /// `collider_vertices` copied vertices.
+  /// One map per mesh (shells, then colliders with hierarchies), in their order in the
+  /// concatenated arrays, then `collider_vertices` copied vertices.
   explicit SystemProlongation(std::vector<ShellProlongation> shells, int collider_vertices = 0);
 
   [[nodiscard]] Eigen::Index coarse_size() const { return 3 * Eigen::Index(coarse_vertices_); }

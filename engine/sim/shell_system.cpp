@@ -79,10 +79,11 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
   // A vertex pinned by two sets keeps the first one's motion.
   std::set<int> seen;
   std::erase_if(pinned_, [&](const PinnedVertex& p) { return !seen.insert(p.vertex).second; });
-  add_colliders();
+  add_colliders(scene_collider_meshes());
 }
 
-ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells)
+ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
+                         const std::vector<TriMesh>& colliders)
     : scene_(scene) {
   if (shells.size() != scene_.shells.size())
     throw std::invalid_argument(fmt::format("ShellSystem: {} level meshes for {} shells",
@@ -108,13 +109,26 @@ ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& 
                          &pins[group].motions, group});
     }
   }
-  add_colliders();
+  if (!colliders.empty() && colliders.size() != scene_.colliders.size())
+    throw std::invalid_argument(fmt::format("ShellSystem: {} level meshes for {} colliders",
+                                            colliders.size(), scene_.colliders.size()));
+  add_colliders(colliders.empty() ? scene_collider_meshes() : colliders);
 }
 
-void ShellSystem::add_colliders() {
+std::vector<TriMesh> ShellSystem::scene_collider_meshes() const {
+  std::vector<TriMesh> meshes;
   for (const Collider& collider : scene_.colliders) {
     TriMesh mesh = build_shell_mesh(collider.mesh);
     validate_mesh(mesh, fmt::format("{}: collider '{}'", scene_.source.string(), collider.name));
+    meshes.push_back(std::move(mesh));
+  }
+  return meshes;
+}
+
+void ShellSystem::add_colliders(const std::vector<TriMesh>& meshes) {
+  for (std::size_t c = 0; c < meshes.size(); ++c) {
+    const Collider& collider = scene_.colliders[c];
+    const TriMesh& mesh = meshes[c];
     ColliderBlock block{collider.name,         rest_.vertex_count(),
                         mesh.vertex_count(),   rest_.triangle_count(),
                         mesh.triangle_count(), MeshTopology::build(mesh, collider.name)};
@@ -173,8 +187,13 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
   }
 }
 
-TriMesh ShellSystem::shell_rest_mesh(int shell) const {
-  const ShellBlock& block = shells_.at(shell);
+TriMesh ShellSystem::shell_rest_mesh(int shell) const { return block_rest_mesh(shells_.at(shell)); }
+
+TriMesh ShellSystem::collider_rest_mesh(int collider) const {
+  return block_rest_mesh(colliders_.at(collider));
+}
+
+TriMesh ShellSystem::block_rest_mesh(const MeshBlock& block) const {
   TriMesh mesh;
   mesh.vertices = rest_.vertices.middleRows(block.first_vertex, block.vertex_count);
   mesh.triangles = rest_.triangles.middleRows(block.first_triangle, block.triangle_count).array() -

@@ -52,9 +52,12 @@ class ShellSystem {
   /// motions) with the given rest meshes; each pinned vertex follows its set's motions from its
   /// own rest position. External force is gravity on this level's masses; loads are selected
   /// on the finest mesh only, so they are left out (the progressive solver applies the finest
-  /// external force through the prolongation).
+  /// external force through the prolongation). `colliders` are the colliders' rest meshes at
+  /// this level, one per scene collider in order (each vertex follows its collider's motions
+  /// from its own rest position); empty: the scene's own collider meshes.
   /// @throws std::invalid_argument when the meshes or pin groups do not fit the scene.
-  ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells);
+  ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
+              const std::vector<TriMesh>& colliders = {});
   // Pins point into scene_'s motions: the system stays where it was built.
   ShellSystem(const ShellSystem&) = delete;
   ShellSystem& operator=(const ShellSystem&) = delete;
@@ -65,6 +68,9 @@ class ShellSystem {
   /// Shell `shell`'s rest mesh in its own vertex numbering (local vertex i is global vertex
   /// shells()[shell].first_vertex + i).
   [[nodiscard]] TriMesh shell_rest_mesh(int shell) const;
+  /// Collider `collider`'s rest mesh in its own vertex numbering (local vertex i is global
+  /// vertex colliders()[collider].first_vertex + i).
+  [[nodiscard]] TriMesh collider_rest_mesh(int collider) const;
   /// The colliders, whose vertices and triangles follow the shells' in rest_mesh().
   [[nodiscard]] const std::vector<ColliderBlock>& colliders() const { return colliders_; }
   [[nodiscard]] const std::vector<MembraneEnergy>& membranes() const { return membranes_; }
@@ -85,9 +91,13 @@ class ShellSystem {
  private:
   /// Concatenates the shells' meshes (in scene order) with their energies, masses and gravity.
   void add_shells(const std::vector<TriMesh>& meshes);
-  /// Appends the scene's colliders after the shells: rest mesh, zero mass and force, and every
-  /// collider vertex as a pinned vertex following the collider's motions.
-  void add_colliders();
+  /// The rest mesh of one block in its own vertex numbering.
+  [[nodiscard]] TriMesh block_rest_mesh(const MeshBlock& block) const;
+  /// The scene's collider meshes, built from their sources and validated.
+  [[nodiscard]] std::vector<TriMesh> scene_collider_meshes() const;
+  /// Appends the colliders (one mesh per scene collider) after the shells: rest mesh, zero mass
+  /// and force, and every collider vertex as a pinned vertex following the collider's motions.
+  void add_colliders(const std::vector<TriMesh>& meshes);
 
   Scene scene_;
   TriMesh rest_;

@@ -239,6 +239,27 @@ TEST(BuildHierarchy, RejectsBadSettings) {
   }
 }
 
+TEST(BuildHierarchy, AllowingFewerLevelsEndsTheHierarchyWhereNoCollapseIsLeft) {
+  // Every vertex its own pinned set: level 0 cannot be made, so with fewer levels allowed the
+  // hierarchy is the input mesh alone instead of an error; a mesh that decimates twice but not
+  // three times ends after its reachable levels.
+  const TriMesh sheet = make_sheet({.edge_length = 0.2, .holes = {}, .structured = true});
+  std::vector<int> pins(sheet.vertex_count());
+  std::iota(pins.begin(), pins.end(), 0);
+  const MeshHierarchy alone =
+      build_hierarchy(sheet, pins, {.levels = 3, .allow_fewer_levels = true});
+  ASSERT_EQ(alone.level_count(), 1);
+  EXPECT_EQ(alone.finest().rest.vertices, sheet.vertices);
+  const TriMesh square = make_sheet({.edge_length = 0.5, .holes = {}, .structured = true});
+  const MeshHierarchy deep =
+      build_hierarchy(square, {}, {.levels = 12, .allow_fewer_levels = true});
+  EXPECT_GT(deep.level_count(), 1);
+  EXPECT_LT(deep.level_count(), 12);
+  for (int l = 0; l + 1 < deep.level_count(); ++l)
+    EXPECT_LT(deep.levels[l].rest.vertex_count(), deep.levels[l + 1].rest.vertex_count());
+  EXPECT_THROW(build_hierarchy(square, {}, {.levels = 12}), InputError);
+}
+
 TEST(BuildHierarchy, OneLevelIsTheInputMesh) {
   const TriMesh sheet = make_sheet({.edge_length = 0.2, .holes = {}, .structured = true});
   const MeshHierarchy h = build_hierarchy(sheet, {}, {.levels = 1});

@@ -74,6 +74,9 @@ TEST(HierarchyCache, KeyDependsOnMeshPinsAndSettings) {
   EXPECT_NE(key, hierarchy_cache_key(cache_mesh(), pins, kSettings));
   EXPECT_NE(key, hierarchy_cache_key(cache_mesh(), {}, {.levels = 2, .vertex_ratio = 0.3}));
   EXPECT_NE(key, hierarchy_cache_key(cache_mesh(), {}, {.levels = 3, .vertex_ratio = 0.25}));
+  HierarchySettings fewer = kSettings;
+  fewer.allow_fewer_levels = true;
+  EXPECT_NE(key, hierarchy_cache_key(cache_mesh(), {}, fewer));
 }
 
 TEST(HierarchyCache, DamagedTruncatedOrForeignFilesAreRebuilt) {

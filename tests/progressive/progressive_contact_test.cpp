@@ -215,6 +215,53 @@ TEST(ProgressiveContact, CrushIsIntersectionFreeAtEveryLevelAndConverges) {
   for (const RefinementStats& r : run.refinements) EXPECT_GT(r.final_gap, 1e-2 * r.smallest_gap);
 }
 
+TEST(ProgressiveContact, CollidersAreDecimatedAndEndAtTheirScriptedPlaces) {
+  // Paper §4.6: the pressing ball has a hierarchy like the sheet's. Its coarse levels keep a
+  // subset of its own vertices (so one rigid motion places every level alike), its refinements
+  // expand it with the sheet, and at the finest level every one of its vertices is where the
+  // script puts it, while every state stays free of intersections.
+  const Scene scene = scene_from(test::kPressScene, "press");
+  ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
+  settings.schedule.levels = 3;
+  ProgressiveSimulation sim(scene, settings);
+  const ShellSystem& finest = sim.finest_system();
+  ASSERT_EQ(finest.colliders().size(), 1u);
+  const ColliderBlock& ball = finest.colliders().front();
+  const Positions finest_ball = finest.collider_rest_mesh(0).vertices;
+  std::vector<int> ball_vertices;
+  std::size_t intersecting = 0;
+  const auto check = [&] {
+    const ShellSystem& system = sim.level_system();
+    intersecting += intersections(system, sim.positions()) > 0;
+    if (ball_vertices.empty() || ball_vertices.back() != system.colliders().front().vertex_count)
+      ball_vertices.push_back(system.colliders().front().vertex_count);
+  };
+  check();
+  const Positions coarse_ball = sim.level_system().collider_rest_mesh(0).vertices;
+  for (Eigen::Index v = 0; v < coarse_ball.rows(); ++v) {
+    const double nearest =
+        (finest_ball.rowwise() - coarse_ball.row(v)).rowwise().norm().minCoeff();
+    EXPECT_EQ(nearest, 0.0) << "coarse ball vertex " << v << " is not a vertex of the ball";
+  }
+  test::run_to_end(sim, check);
+  ASSERT_TRUE(sim.finished());
+  EXPECT_TRUE(sim.level_converged());
+  EXPECT_EQ(intersecting, 0u);
+  ASSERT_EQ(ball_vertices.size(), 3u);
+  EXPECT_LT(ball_vertices[0], ball_vertices[1]);
+  EXPECT_LT(ball_vertices[1], ball.vertex_count);
+  EXPECT_EQ(ball_vertices[2], ball.vertex_count);
+  Eigen::VectorXd scripted = sim.positions();
+  finest.apply_pins(scripted, sim.frame() * scene.time.step);
+  const Eigen::Index first = 3 * Eigen::Index(ball.first_vertex);
+  const Eigen::Index count = 3 * Eigen::Index(ball.vertex_count);
+  EXPECT_LT((sim.positions().segment(first, count) - scripted.segment(first, count))
+                .lpNorm<Eigen::Infinity>(),
+            1e-12);
+  std::cout << "press: ball vertices per level " << ball_vertices[0] << ", " << ball_vertices[1]
+            << ", " << ball_vertices[2] << "\n";
+}
+
 TEST(ProgressiveContact, PressMatchesTheDirectFineEquilibrium) {
   // The pressed sheet's equilibrium is unique: the progressive finest answer and a direct solve
   // of the same frames must agree within 1e-3 of the bounding-box diagonal.
