@@ -37,29 +37,37 @@ constexpr double kEnergyRoundoff = 1e-12;
 /// Watches a solve for stagnation at round-off (NewtonResult::stagnated): the step norm stops
 /// falling while the energy changes only by its rounding. A slow solve that still lowers E
 /// (backtracking through a fold, contact) is not stagnating, however long its step norms wander.
+/// E is judged per window of iterations, not since the best step norm: one real drop of E (a
+/// late snap) must not hide the rounding-level changes that follow it.
 class RoundoffStagnation {
  public:
-  /// Iterations without the step norm halving before a solve that did not lower E beyond its
-  /// rounding meanwhile has stagnated.
+  /// Iterations without the step norm halving, and without E falling beyond its rounding,
+  /// before a solve has stagnated.
   static constexpr int kWindow = 10;
 
   /// Takes an iteration's step norm and its starting energy; true once stagnated.
   bool stagnated(double step_norm, double energy) {
     if (step_norm < 0.5 * best_step_norm_) {
       best_step_norm_ = step_norm;
-      energy_at_best_ = energy;
-      iterations_since_best_ = 0;
+      start_window(energy);
       return false;
     }
-    ++iterations_since_best_;
-    return iterations_since_best_ >= kWindow &&
-           energy_at_best_ - energy <= kWindow * kEnergyRoundoff * std::abs(energy);
+    if (++iterations_in_window_ < kWindow) return false;
+    if (energy_at_window_start_ - energy <= kWindow * kEnergyRoundoff * std::abs(energy))
+      return true;
+    start_window(energy);
+    return false;
   }
 
  private:
+  void start_window(double energy) {
+    energy_at_window_start_ = energy;
+    iterations_in_window_ = 0;
+  }
+
   double best_step_norm_ = std::numeric_limits<double>::infinity();
-  double energy_at_best_ = 0.0;
-  int iterations_since_best_ = 0;
+  double energy_at_window_start_ = 0.0;
+  int iterations_in_window_ = 0;
 };
 
 void check_settings(const NewtonSettings& s) {

@@ -573,12 +573,16 @@ TEST(Newton, NegativeDefiniteHessianFallsBackToGradient) {
 /// deterministic error of relative size `noise` (as a gradient summed from large cancelling
 /// element forces does): Newton gets within about `noise` of the minimum and then only moves in
 /// the error, with energy changes far below the rounding of E.
+/// With `late_drop`, E also falls by that much once the gradient has been evaluated
+/// `drop_after` times: a real decrease (a fold snapping) after the step norm stopped falling.
 class NoisyQuadratic : public Objective {
  public:
-  NoisyQuadratic(int vertices, double noise) : n_(3 * vertices), noise_(noise) {}
+  NoisyQuadratic(int vertices, double noise, double late_drop = 0.0, long drop_after = 0)
+      : n_(3 * vertices), noise_(noise), late_drop_(late_drop), drop_after_(drop_after) {}
   [[nodiscard]] Eigen::Index size() const override { return n_; }
   double value(const Eigen::VectorXd& x) override {
-    return kOffset + 0.5 * (x.array() - 1.0).square().sum();
+    const double drop = evaluations_ >= drop_after_ ? late_drop_ : 0.0;
+    return kOffset - drop + 0.5 * (x.array() - 1.0).square().sum();
   }
   void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
     ++evaluations_;
@@ -595,6 +599,8 @@ class NoisyQuadratic : public Objective {
   static constexpr double kOffset = 1e6;
   Eigen::Index n_;
   double noise_;
+  double late_drop_;
+  long drop_after_;
   long evaluations_ = 0;
 };
 
@@ -612,6 +618,23 @@ TEST(Newton, StagnationAtRoundoffStopsAndSaysSo) {
   // The accuracy reached is the gradient error's, and the iterate is that close to the minimum.
   EXPECT_LT(result.step_norm, 1e-8);
   EXPECT_GT(result.step_norm, settings.tolerance);
+  EXPECT_LT((x.array() - 1.0).abs().maxCoeff(), 1e-8);
+}
+
+TEST(Newton, StagnationIsFoundAfterALateRealDropOfTheEnergy) {
+  // E falls by 1e-3 (1e-9 of |E|, far above its rounding) at iteration 5, after the step
+  // norm stopped halving; only rounding-level changes follow. Judged against the energy at the
+  // best step norm, that one drop hid the stagnation for all 400 iterations.
+  NoisyQuadratic objective(4, 1e-9, 1e-3, 5);
+  NewtonSettings settings;
+  settings.tolerance = 1e-12;
+  settings.max_iterations = 400;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(objective.size());
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(4, {}), settings);
+  EXPECT_TRUE(result.stagnated);
+  EXPECT_GT(result.iterations, 15);  // the window with the drop did not count
+  EXPECT_LT(result.iterations, 50);
   EXPECT_LT((x.array() - 1.0).abs().maxCoeff(), 1e-8);
 }
 
