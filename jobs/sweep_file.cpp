@@ -5,14 +5,13 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <set>
-#include <sstream>
 #include <system_error>
 
 #include "engine/core/error.hpp"
+#include "engine/core/input_file.hpp"
 #include "engine/scene/key_suggestion.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "jobs/scene_overrides.hpp"
@@ -292,11 +291,7 @@ class SweepReader {
 
 Sweep read_sweep(const fs::path& file) {
   const fs::path absolute = fs::absolute(file);
-  std::ifstream in(absolute, std::ios::binary);
-  if (!in) throw InputError(located_message(absolute.string(), 0, "cannot open the sweep file"));
-  std::stringstream text;
-  text << in.rdbuf();
-  return read_sweep_text(text.str(), absolute);
+  return read_sweep_text(read_input_file(absolute, "sweep file"), absolute);
 }
 
 Sweep read_sweep_text(std::string_view text, const fs::path& file) {

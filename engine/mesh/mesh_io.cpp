@@ -4,13 +4,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
+#include "engine/core/input_file.hpp"
 #include "engine/mesh/mesh_io_formats.hpp"
 
 namespace psq {
@@ -30,28 +27,12 @@ MeshFormat format_of(const std::filesystem::path& path) {
       fmt::format("unknown mesh file extension '{}'; use .obj, .ply or .off", extension)));
 }
 
-std::string read_bytes(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  std::error_code error;
-  if (!std::filesystem::exists(path, error))
-    throw InputError(located_message(file, 0, "no such file"));
-  if (!std::filesystem::is_regular_file(path, error))
-    throw InputError(located_message(file, 0, "not a regular file"));
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw InputError(
-        located_message(file, 0, fmt::format("cannot open: {}", std::strerror(errno))));
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(located_message(file, 0, "read error"));
-  return bytes;
-}
-
 }  // namespace
 
 TriMesh read_mesh(const std::filesystem::path& path) {
   const std::string file = path.string();
   const MeshFormat format = format_of(path);
-  const std::string bytes = read_bytes(path);
+  const std::string bytes = read_input_file(path, "mesh file");
   ParsedMesh parsed;
   switch (format) {
     case MeshFormat::obj: parsed = parse_obj(bytes, file); break;

@@ -7,12 +7,11 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <type_traits>
 
 #include "engine/core/error.hpp"
+#include "engine/core/input_file.hpp"
 #include "engine/scene/key_suggestion.hpp"
 
 namespace psq {
@@ -712,11 +711,7 @@ toml::table parse_toml(std::string_view text, const std::string& source) {
 }  // namespace
 
 Scene read_scene(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(located_message(path.string(), 0, "cannot open the scene file"));
-  std::stringstream text;
-  text << in.rdbuf();
-  return read_scene_text(text.str(), path);
+  return read_scene_text(read_input_file(path, "scene file"), path);
 }
 
 Scene read_scene_text(std::string_view text, const fs::path& path) {

@@ -204,7 +204,7 @@ TEST(MeshIo, ConnectivityErrorsNameTheFile) {
 
 TEST(MeshIo, UnreadableFilesAndUnknownExtensions) {
   const auto dir = test::fresh_temp_dir("mesh-io");
-  expect_input_error([&] { read_mesh(dir / "missing.obj"); }, {"missing.obj", "no such file"});
+  expect_input_error([&] { read_mesh(dir / "missing.obj"); }, {"missing.obj", "no such mesh file"});
   std::filesystem::create_directory(dir / "folder.obj");
   expect_input_error([&] { read_mesh(dir / "folder.obj"); }, {"folder.obj"});
   const auto stl = test::write_file(dir / "mesh.stl", "solid x\nendsolid x\n");
