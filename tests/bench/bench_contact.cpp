@@ -7,11 +7,14 @@
 // coarse size, whose layers meet only in the last third of its frames. (drape_sphere with the
 // cloth 20 cm higher shows no more: each free-fall frame takes about one Newton iteration.)
 //
-// Usage: bench_contact [--scale S]   (S multiplies every mesh edge length; default 1 = the sizes
-//                                     below, chosen to run in about a minute)
+// Usage: bench_contact [--scale S] [--scenes a,b] [--frames N] [--skips on|off]
+//   S multiplies every mesh edge length (default 1: the sizes below, chosen to run in about a
+//   minute); --scenes picks scenes of the table, --frames overrides their frame counts (large
+//   sizes: the first frames of contact), --skips off leaves out the skip comparison.
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 #include <vector>
@@ -42,6 +45,23 @@ const std::vector<Case> kCases = {
 void set_edge_length(MeshSource& mesh, double edge) {
   if (edge <= 0) return;
   mesh.sheet.edge_length = mesh.cylinder.edge_length = mesh.sphere.edge_length = edge;
+}
+
+/// The cases named on the command line (all by default), each with its frame count or `frames`.
+std::vector<Case> chosen_cases(const psq::bench::BenchOptions& options) {
+  std::vector<Case> chosen;
+  const std::vector<std::string> names =
+      options.given("scenes") ? options.texts("scenes") : std::vector<std::string>{};
+  for (const Case& c : kCases)
+    if (names.empty() || std::find(names.begin(), names.end(), c.scene) != names.end())
+      chosen.push_back(c);
+  for (const std::string& name : names)
+    if (std::none_of(kCases.begin(), kCases.end(), [&](const Case& c) { return c.scene == name; }))
+      psq::bench::reject_value("scenes", name,
+                               "one of drape_sphere, twist_wrap, cylinder_crush, bunny_press");
+  if (options.given("frames"))
+    for (Case& c : chosen) c.frames = options.integer("frames");
+  return chosen;
 }
 
 Scene load(const Case& c, double scale, bool skip) {
@@ -136,7 +156,10 @@ int bench_contact(const psq::bench::BenchOptions& options) {
   fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
              "vertices", "iters", "elastic+", "contact", "friction", "CCD", "factor", "wall",
              "converged");
-  for (const Case& c : kCases) print_split(c.scene, run(load(c, scale, true)));
+  for (const Case& c : chosen_cases(options)) print_split(c.scene, run(load(c, scale, true)));
+  const std::string skips = options.text("skips");
+  if (skips != "on" && skips != "off") psq::bench::reject_value("skips", skips, "on or off");
+  if (skips == "off") return 0;
 
   // Scenes where contact happens in some frames only: the cloth's free fall onto the ball (cheap
   // frames), and the twisted sheet whose layers meet around frame 9 of 14 (costly frames).
@@ -152,7 +175,12 @@ int bench_contact(const psq::bench::BenchOptions& options) {
 int main(int argc, char** argv) {
   using psq::bench::OptionType;
   psq::bench::BenchOptions options(
-      "bench_contact", {{"scale", OptionType::positive_number, "1",
-                         "factor on every mesh edge length; 1: the sizes for about a minute"}});
+      "bench_contact",
+      {{"scale", OptionType::positive_number, "1",
+        "factor on every mesh edge length; 1: the sizes for about a minute"},
+       {"scenes", OptionType::text_list, "",
+        "scenes of the table to run (drape_sphere,twist_wrap,cylinder_crush,bunny_press)"},
+       {"frames", OptionType::count, "", "frames of each scene (default: the table's)"},
+       {"skips", OptionType::text, "on", "on: also compare the skips on and off; off: do not"}});
   return psq::bench::run_benchmark(options, argc, argv, bench_contact);
 }
