@@ -9,7 +9,7 @@
 namespace psq {
 
 /// The bytes of `path`. `what` names the kind of file in the messages ("scene file").
-/// @throws InputError naming `path`: "no such <what>", "<what> is not a regular file",
+/// @throws InputError naming `path`: "no such <what>", "the <what> is not a regular file",
 ///   "cannot open the <what>: <system reason>" or "read error in the <what>".
 std::string read_input_file(const std::filesystem::path& path, std::string_view what);
 

@@ -13,6 +13,7 @@
 //   sizes: the first frames of contact), --skips off leaves out the skip comparison.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <chrono>
@@ -55,10 +56,11 @@ std::vector<Case> chosen_cases(const psq::bench::BenchOptions& options) {
   for (const Case& c : kCases)
     if (names.empty() || std::find(names.begin(), names.end(), c.scene) != names.end())
       chosen.push_back(c);
+  std::vector<std::string> known;
+  for (const Case& c : kCases) known.push_back(c.scene);
   for (const std::string& name : names)
-    if (std::none_of(kCases.begin(), kCases.end(), [&](const Case& c) { return c.scene == name; }))
-      psq::bench::reject_value("scenes", name,
-                               "one of drape_sphere, twist_wrap, cylinder_crush, bunny_press");
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      psq::bench::reject_value("scenes", name, fmt::format("one of {}", fmt::join(known, ", ")));
   if (options.given("frames"))
     for (Case& c : chosen) c.frames = options.integer("frames");
   return chosen;
@@ -156,9 +158,11 @@ int bench_contact(const psq::bench::BenchOptions& options) {
   fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
              "vertices", "iters", "elastic+", "contact", "friction", "CCD", "factor", "wall",
              "converged");
-  for (const Case& c : chosen_cases(options)) print_split(c.scene, run(load(c, scale, true)));
+  // Both options are checked before the first run, which may take minutes.
+  const std::vector<Case> cases = chosen_cases(options);
   const std::string skips = options.text("skips");
   if (skips != "on" && skips != "off") psq::bench::reject_value("skips", skips, "on or off");
+  for (const Case& c : cases) print_split(c.scene, run(load(c, scale, true)));
   if (skips == "off") return 0;
 
   // Scenes where contact happens in some frames only: the cloth's free fall onto the ball (cheap

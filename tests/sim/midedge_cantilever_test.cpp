@@ -95,8 +95,9 @@ double tip_deflection_ratio(double edge_length, double poisson_ratio,
   StaticStrip strip(rest, material, split, force);
   Eigen::VectorXd x = flat(rest.vertices);
   NewtonSettings settings;
-  // metres: 1e-5 of the deflection. Below about 3e-9 m the projected Newton steps of this stiff
-  // strip are set by rounding, and where that floor lies depends on the CPU's BLAS kernels.
+  // metres: 1e-5 of the deflection. At 1e-6 of it (1e-9 m) this stiff strip's Newton steps
+  // reach their rounding floor, which lies differently on CPUs whose BLAS kernels round
+  // differently: there the solve stagnates instead of converging.
   settings.tolerance = 1e-8;
   const NewtonResult result =
       NewtonSolver().minimize(strip, x, DofMap(rest.vertex_count(), pinned), settings);
