@@ -154,14 +154,14 @@ void print_skip_speedup(const Case& c, double scale, const std::string& when) {
 /// Prints the phase split and the skips' speed-ups; the command line is read by run_benchmark.
 int bench_contact(const psq::bench::BenchOptions& options) {
   const double scale = options.number("scale");
-  fmt::print("time per Newton iteration [ms]\n");
-  fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
-             "vertices", "iters", "elastic+", "contact", "friction", "CCD", "factor", "wall",
-             "converged");
   // Both options are checked before the first run, which may take minutes.
   const std::vector<Case> cases = chosen_cases(options);
   const std::string skips = options.text("skips");
   if (skips != "on" && skips != "off") psq::bench::reject_value("skips", skips, "on or off");
+  fmt::print("time per Newton iteration [ms]\n");
+  fmt::print("{:<16} {:>8} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "scene",
+             "vertices", "iters", "elastic+", "contact", "friction", "CCD", "factor", "wall",
+             "converged");
   for (const Case& c : cases) print_split(c.scene, run(load(c, scale, true)));
   if (skips == "off") return 0;
 
