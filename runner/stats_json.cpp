@@ -24,6 +24,7 @@ nlohmann::json contact_json(const FrameRecord& r) {
           {"ccd_skips", c.ccd_skips},
           {"ccd_certified", c.ccd_certified},
           {"certificate_renewals", c.certificate_renewals},
+          {"motion_reuses", c.motion_reuses},
           {"ccd_pair_queries", c.ccd_pair_queries},
           {"broad_phase_seconds", c.broad_phase_seconds},
           {"barrier_seconds", c.barrier_seconds},

@@ -29,6 +29,10 @@ using Gradient12 = Eigen::Matrix<double, 12, 1>;
 /// with the candidates within reach + 2 r_max. See docs/contact.md for the measurements.
 constexpr double kMaxCertificateRadius = 16.0;
 
+/// A state counts as on the last CCD query's motion when it is within this many ε_mach of its
+/// largest coordinate of a point of it: x + α d computed in doubles is within a few.
+constexpr double kMotionRoundingFactor = 64.0;
+
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
 
 /// m(c) b(d − ξ²) of one pair (m = 1 for point–triangle), +∞ within the thickness.
@@ -189,6 +193,7 @@ ContactStats& ContactStats::operator+=(const ContactStats& other) {
   barrier_certified += other.barrier_certified;
   ccd_certified += other.ccd_certified;
   certificate_renewals += other.certificate_renewals;
+  motion_reuses += other.motion_reuses;
   max_active_pairs = std::max(max_active_pairs, other.max_active_pairs);
   broad_phase_seconds += other.broad_phase_seconds;
   barrier_seconds += other.barrier_seconds;
@@ -217,7 +222,8 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
   active_.clear();
   min_distance_ = kInfinity;
   cached_x_ = x;
-  ContactCandidates candidates;
+  ContactCandidates searched;
+  const ContactCandidates* candidates = &motion_candidates_;
   {
     ScopedTimer timer(stats_.broad_phase_seconds);
     if (parameters_.skip_when_apart && certificate_.covers(x)) {
@@ -229,10 +235,15 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
       ++stats_.barrier_skips;
       return;
     }
-    candidates = broad_phase_.distance_candidates(as_positions(x), reach());
+    if (on_searched_motion(x)) {
+      ++stats_.motion_reuses;
+    } else {
+      searched = broad_phase_.distance_candidates(as_positions(x), reach());
+      candidates = &searched;
+    }
   }
   ScopedTimer timer(stats_.barrier_seconds);
-  std::vector<ContactPair> pairs = candidate_pairs(candidates, broad_phase_);
+  std::vector<ContactPair> pairs = candidate_pairs(*candidates, broad_phase_);
   std::vector<double> distance(pairs.size());
   tbb::parallel_for(std::size_t{0}, pairs.size(),
                     [&](std::size_t k) { distance[k] = pair_distance(pairs[k], x); });
@@ -251,6 +262,14 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
     min_distance_ = std::min(min_distance_, distance[k]);
   }
   stats_.max_active_pairs = std::max(stats_.max_active_pairs, static_cast<long>(active_.size()));
+}
+
+bool ContactPotential::on_searched_motion(const Eigen::VectorXd& x) const {
+  if (motion_.size() != x.size()) return false;
+  const double length = motion_.squaredNorm();
+  const double along = length > 0 ? (x - motion_start_).dot(motion_) / length : 0.0;
+  const double t = std::clamp(along, 0.0, 1.0);
+  return (x - motion_start_ - t * motion_).lpNorm<Eigen::Infinity>() <= motion_tolerance_;
 }
 
 bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
@@ -350,10 +369,16 @@ double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen
     ++stats_.ccd_skips;
     return 1.0;
   }
-  const ContactCandidates candidates =
-      broad_phase_.swept_candidates(start, end, parameters_.band.thickness);
-  stats_.ccd_pair_queries += static_cast<long>(candidates.size());
-  return smallest_time_of_impact(candidate_pairs(candidates, broad_phase_), x, x + dx, parameters_.ccd);
+  // A state on the motion lies within rounding (tolerance) of a point of it, and a pair's
+  // distance moves at most twice as far as its vertices: the slack keeps such pairs found.
+  motion_tolerance_ = kMotionRoundingFactor * std::numeric_limits<double>::epsilon() *
+                      std::max(start.cwiseAbs().maxCoeff(), end.cwiseAbs().maxCoeff());
+  motion_candidates_ = broad_phase_.swept_candidates(start, end, reach() + 2 * motion_tolerance_);
+  motion_start_ = x;
+  motion_ = dx;
+  stats_.ccd_pair_queries += static_cast<long>(motion_candidates_.size());
+  return smallest_time_of_impact(candidate_pairs(motion_candidates_, broad_phase_), x, x + dx,
+                                 parameters_.ccd);
 }
 
 }  // namespace psq

@@ -62,6 +62,7 @@ struct ContactStats {
   long barrier_certified = 0;      ///< of the barrier skips, those the certificate answered
   long ccd_certified = 0;          ///< of the CCD skips, those the certificate answered
   long certificate_renewals = 0;   ///< clearance queries that issued a certificate
+  long motion_reuses = 0;          ///< states whose candidates the last CCD query's search gave
   long max_active_pairs = 0;       ///< the most pairs within reach at one state
   double broad_phase_seconds = 0;  ///< early-outs and candidate searches of the barrier
   double barrier_seconds = 0;      ///< distances, barrier values and derivatives
@@ -134,6 +135,9 @@ class ContactPotential {
   /// The largest α ≤ 1 such that the linear motion x → x + α dx keeps every pair farther
   /// apart than ξ: the minimum additive-CCD time of impact over the swept candidates (each
   /// already conservative: the gap keeps at least ccd.ratio_bound of its start value).
+  /// The candidates are searched within reach of the motion and kept: every state on it (the
+  /// line search's trials, the accepted iterate) then finds its pairs among them instead of
+  /// searching the whole surface again, so a Newton iteration pays for one search.
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx);
 
   /// The clearance certificate of the skips (radius < 0 while there is none).
@@ -144,6 +148,9 @@ class ContactPotential {
 
  private:
   void refresh(const Eigen::VectorXd& x);
+  /// Whether x lies on the motion of the last CCD query (to rounding, which the search's slack
+  /// covers), so that its candidates hold every pair within reach at x.
+  [[nodiscard]] bool on_searched_motion(const Eigen::VectorXd& x) const;
   bool renew_certificate(const Eigen::VectorXd& x);
   void accumulate_gradient(const Eigen::VectorXd& x, double scale, Eigen::VectorXd& g);
 
@@ -157,6 +164,11 @@ class ContactPotential {
   std::vector<ContactPair> active_;
   double min_distance_ = 0;
   ClearanceCertificate certificate_;
+  // The last CCD query's motion start → start + motion and its candidates within reach + slack.
+  Eigen::VectorXd motion_start_;
+  Eigen::VectorXd motion_;
+  double motion_tolerance_ = 0;
+  ContactCandidates motion_candidates_;
 };
 
 }  // namespace psq

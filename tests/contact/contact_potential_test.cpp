@@ -345,6 +345,37 @@ TEST(ContactPotential, SkipsChangeNothingAlongRandomMotions) {
       with_skips.ccd_certified, with_skips.ccd_evaluations, longer_steps);
 }
 
+TEST(ContactPotential, StatesOnTheLastCcdMotionFindThePairsOfAFreshSearch) {
+  // The sheets approach from 4 d̂ to within reach along one CCD query's motion; every state on
+  // it (computed as x + α dx, with its rounding) must see the pairs a fresh search sees, and a
+  // state off the motion must be searched again.
+  std::mt19937 rng(17);
+  TwoSheets sheets = two_sheets(4 * kActivation);
+  for (Eigen::Index i = 2; i < sheets.x.size(); i += 3)
+    sheets.x[i] += 0.3 * kActivation * test::random_point(rng).z();
+  ContactPotential reusing(sheets.surface, parameters(false));
+  ContactPotential searching(sheets.surface, parameters(false));
+  const Eigen::VectorXd dx = upper_moved(sheets, {0.0, 0.0, -3.6 * kActivation}) - sheets.x +
+                             random_motion(sheets.x.size(), 0.1 * kActivation, rng);
+  const double alpha = reusing.max_feasible_step(sheets.x, dx);
+  ASSERT_GT(alpha, 0.5);
+  std::size_t most_pairs = 0;
+  for (const double t : {0.0, 0.25, 0.5, 0.75, 0.9, 1.0}) {
+    const Eigen::VectorXd x = sheets.x + t * alpha * dx;
+    expect_same_pairs(reusing.active_pairs(x), searching.active_pairs(x));
+    most_pairs = std::max(most_pairs, searching.active_pairs(x).size());
+  }
+  EXPECT_GT(most_pairs, 0u);
+  EXPECT_EQ(reusing.stats().motion_reuses, 6);
+
+  // Sideways by a tenth of d̂: no longer on the motion.
+  const Eigen::VectorXd off = sheets.x + alpha * dx + upper_moved(sheets, {1e-4, 0.0, 0.0}) -
+                              sheets.x;
+  expect_same_pairs(reusing.active_pairs(off), searching.active_pairs(off));
+  EXPECT_EQ(reusing.stats().motion_reuses, 6);
+  EXPECT_EQ(searching.stats().motion_reuses, 0);
+}
+
 TEST(ContactPotential, RejectsBadParameters) {
   TwoSheets sheets = two_sheets(kActivation);
   ContactParameters bad = parameters();
