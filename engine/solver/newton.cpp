@@ -272,9 +272,11 @@ double NewtonSolver::extrapolate(Objective& objective, const Eigen::VectorXd& x,
                                  const Eigen::VectorXd& direction, double full_step_energy,
                                  NewtonIteration& record) {
   double accepted = full_step_energy;
-  for (double alpha = 2.0; alpha <= kMaxExtrapolation; alpha *= 2.0) {
-    // The CCD is asked about the whole longer motion: the full step's check does not cover it.
-    if (objective.max_feasible_step(x, alpha * direction) < 1.0) break;
+  // One CCD query covers every longer step: the full step's check does not, and asking about
+  // each α in turn would search the surface for each.
+  const double longest =
+      kMaxExtrapolation * objective.max_feasible_step(x, kMaxExtrapolation * direction);
+  for (double alpha = 2.0; alpha <= longest; alpha *= 2.0) {
     longer_trial_ = x + alpha * direction;
     const double longer_energy = objective.value(longer_trial_);
     ++record.line_search_trials;
