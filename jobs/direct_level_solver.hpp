@@ -37,6 +37,8 @@ class DirectLevelSolver final : public LevelSolver {
             .step_norm = record.newton.step_norm,
             .gradient_norm = record.newton.gradient_norm,
             .elastic_energy = record.elastic_energy,
+            // The record says only that the step or its settling ran out of iterations.
+            .failure = {},
             .times = record.newton.times};
   }
 

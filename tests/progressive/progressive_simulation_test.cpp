@@ -167,8 +167,9 @@ TEST(ProgressiveSimulation, ScheduleStepsPreviewFramesThenSettlesThenRefines) {
     ++settling_steps;
     // A settling step with nothing to solve jumps to the largest time step (growing 4× per step
     // would take up to 5 more steps there).
-    if (step.frame.newton.iterations == 0 && !sim.level_done())
+    if (step.frame.newton.iterations == 0 && !sim.level_done()) {
       EXPECT_EQ(growth(), kSettlingGrowthSteps);
+    }
   }
   EXPECT_GE(settling_steps, 1);
   // Only a step at the largest time step ends the settling.
