@@ -29,10 +29,6 @@ using Gradient12 = Eigen::Matrix<double, 12, 1>;
 /// with the candidates within reach + 2 r_max. See docs/contact.md for the measurements.
 constexpr double kMaxCertificateRadius = 16.0;
 
-/// A state counts as on the last CCD query's motion when it is within this many ε_mach of its
-/// largest coordinate of a point of it: x + α d computed in doubles is within a few.
-constexpr double kMotionRoundingFactor = 64.0;
-
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
 
 /// m(c) b(d − ξ²) of one pair (m = 1 for point–triangle), +∞ within the thickness.
@@ -223,7 +219,7 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
   min_distance_ = kInfinity;
   cached_x_ = x;
   ContactCandidates searched;
-  const ContactCandidates* candidates = &motion_candidates_;
+  const ContactCandidates* candidates = &searched_motion_.candidates;
   {
     ScopedTimer timer(stats_.broad_phase_seconds);
     if (parameters_.skip_when_apart && certificate_.covers(x)) {
@@ -235,7 +231,7 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
       ++stats_.barrier_skips;
       return;
     }
-    if (on_searched_motion(x)) {
+    if (searched_motion_.contains(x)) {
       ++stats_.motion_reuses;
     } else {
       searched = broad_phase_.distance_candidates(as_positions(x), reach());
@@ -264,12 +260,12 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
   stats_.max_active_pairs = std::max(stats_.max_active_pairs, static_cast<long>(active_.size()));
 }
 
-bool ContactPotential::on_searched_motion(const Eigen::VectorXd& x) const {
-  if (motion_.size() != x.size()) return false;
-  const double length = motion_.squaredNorm();
-  const double along = length > 0 ? (x - motion_start_).dot(motion_) / length : 0.0;
-  const double t = std::clamp(along, 0.0, 1.0);
-  return (x - motion_start_ - t * motion_).lpNorm<Eigen::Infinity>() <= motion_tolerance_;
+bool ContactPotential::SearchedMotion::contains(const Eigen::VectorXd& x) const {
+  if (motion.size() != x.size()) return false;
+  const Eigen::VectorXd offset = x - start;
+  const double length = motion.squaredNorm();
+  const double t = length > 0 ? std::clamp(offset.dot(motion) / length, 0.0, 1.0) : 0.0;
+  return (offset - t * motion).lpNorm<Eigen::Infinity>() <= tolerance;
 }
 
 bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
@@ -369,15 +365,16 @@ double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen
     ++stats_.ccd_skips;
     return 1.0;
   }
-  // A state on the motion lies within rounding (tolerance) of a point of it, and a pair's
-  // distance moves at most twice as far as its vertices: the slack keeps such pairs found.
-  motion_tolerance_ = kMotionRoundingFactor * std::numeric_limits<double>::epsilon() *
-                      std::max(start.cwiseAbs().maxCoeff(), end.cwiseAbs().maxCoeff());
-  motion_candidates_ = broad_phase_.swept_candidates(start, end, reach() + 2 * motion_tolerance_);
-  motion_start_ = x;
-  motion_ = dx;
-  stats_.ccd_pair_queries += static_cast<long>(motion_candidates_.size());
-  return smallest_time_of_impact(candidate_pairs(motion_candidates_, broad_phase_), x, x + dx,
+  // A state on the motion lies within rounding (the tolerance) of a point of it, and each box
+  // of a pair moves at most that far per axis: the slack of 2 tolerances keeps its pairs found.
+  SearchedMotion& searched = searched_motion_;
+  searched.tolerance = distance_rounding_margin(
+      std::max(start.cwiseAbs().maxCoeff(), end.cwiseAbs().maxCoeff()));
+  searched.candidates = broad_phase_.swept_candidates(start, end, reach() + 2 * searched.tolerance);
+  searched.start = x;
+  searched.motion = dx;
+  stats_.ccd_pair_queries += static_cast<long>(searched.candidates.size());
+  return smallest_time_of_impact(candidate_pairs(searched.candidates, broad_phase_), x, x + dx,
                                  parameters_.ccd);
 }
 

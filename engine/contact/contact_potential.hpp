@@ -147,10 +147,20 @@ class ContactPotential {
   void reset_stats() { stats_ = ContactStats{}; }
 
  private:
+  /// The last CCD query's motion start → start + motion, with its swept candidates within
+  /// reach + 2 tolerance.
+  struct SearchedMotion {
+    Eigen::VectorXd start;
+    Eigen::VectorXd motion;
+    double tolerance = 0;
+    ContactCandidates candidates;
+
+    /// Whether x lies on the motion to within the tolerance (the rounding of start + α motion,
+    /// which the search's slack covers), so that the candidates hold every pair within reach at x.
+    [[nodiscard]] bool contains(const Eigen::VectorXd& x) const;
+  };
+
   void refresh(const Eigen::VectorXd& x);
-  /// Whether x lies on the motion of the last CCD query (to rounding, which the search's slack
-  /// covers), so that its candidates hold every pair within reach at x.
-  [[nodiscard]] bool on_searched_motion(const Eigen::VectorXd& x) const;
   bool renew_certificate(const Eigen::VectorXd& x);
   void accumulate_gradient(const Eigen::VectorXd& x, double scale, Eigen::VectorXd& g);
 
@@ -164,11 +174,7 @@ class ContactPotential {
   std::vector<ContactPair> active_;
   double min_distance_ = 0;
   ClearanceCertificate certificate_;
-  // The last CCD query's motion start → start + motion and its candidates within reach + slack.
-  Eigen::VectorXd motion_start_;
-  Eigen::VectorXd motion_;
-  double motion_tolerance_ = 0;
-  ContactCandidates motion_candidates_;
+  SearchedMotion searched_motion_;
 };
 
 }  // namespace psq
