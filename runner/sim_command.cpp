@@ -188,8 +188,10 @@ int run_progressive(const Scene& scene, const SimOptions& sim_options,
   bool all_converged = true;
   for (;;) {
     const bool finest = sim.finest_level();
-    LevelRecord level{sim.level(), sim.level_rest_mesh().vertex_count(),
-                      sim.level_rest_mesh().triangle_count()};
+    LevelRecord level;
+    level.level = sim.level();
+    level.vertices = sim.level_rest_mesh().vertex_count();
+    level.triangles = sim.level_rest_mesh().triangle_count();
     while (!sim.level_done()) {
       const ProgressiveStep step = sim.step([&](int l, int frame, const NewtonIteration& it) {
         if (terminal)
