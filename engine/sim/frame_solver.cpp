@@ -28,6 +28,10 @@ constexpr int kStiffnessUpdateInterval = 10;
 /// A step whose CCD bound is below this fraction of the Newton step creeps: a pair ahead of it
 /// is so close that the barrier, too weak for the force pressing it, lets Newton aim through.
 constexpr double kCreepingStep = 0.1;
+/// Consecutive creeping steps after which a chunk ends early for a κ update: waiting for the
+/// whole chunk lets a plate pressed onto a can's rim creep for tens of iterations between
+/// doublings of κ (IPC updates κ after every iteration).
+constexpr int kCreepingRun = 2;
 
 /// Outer friction iterations (lag, solve) per frame at most; tilted_plane frames settle in 2–3.
 constexpr int kMaxFrictionIterations = 5;
@@ -164,6 +168,13 @@ NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs
   // Numbered within the whole solve, across the chunks.
   const NewtonSolver::Progress numbered = offset_progress(progress, done);
   NewtonSettings chunk = settings;
+  // Only the barrier's κ answers creeping, and only where the CCD alone bounds the steps: with
+  // strain limits the bound may be the limit's, which no κ relaxes (a strain-limited press
+  // then refined into a state the strain correction could not bring back under its limit).
+  if (contact_ && !strain_limit_) {
+    chunk.max_cut_steps = kCreepingRun;
+    chunk.cut_step = kCreepingStep;
+  }
   while (true) {
     chunk.max_iterations = std::min(interval, settings.max_iterations - done);
     // An inner chunk's last iterate is judged by the next chunk's first iteration, which

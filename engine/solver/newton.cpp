@@ -83,6 +83,8 @@ void check_settings(const NewtonSettings& s) {
   require(s.backtracking > 0.0 && s.backtracking < 1.0, "backtracking", s.backtracking,
           "in (0, 1)");
   require(s.min_step > 0.0 && s.min_step <= 1.0, "min_step", s.min_step, "in (0, 1]");
+  require(s.max_cut_steps >= 0, "max_cut_steps", s.max_cut_steps, ">= 0");
+  require(s.cut_step > 0.0 && s.cut_step <= 1.0, "cut_step", s.cut_step, "in (0, 1]");
 }
 
 std::string dof_name(Eigen::Index dof) {
@@ -145,6 +147,7 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
   Eigen::VectorXd gradient;
   Eigen::VectorXd free_gradient;
   RoundoffStagnation stagnation;
+  int consecutive_cut_steps = 0;
   for (int k = 0;; ++k) {
     record.iteration = k;
     record.energy = energy;
@@ -173,6 +176,8 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     if (progress) progress(record);
     if (result.converged || result.stagnated || k == settings.max_iterations) break;
     if (k + 1 == settings.max_iterations && !settings.judge_final_iterate) break;
+    consecutive_cut_steps = record.feasible_step < settings.cut_step ? consecutive_cut_steps + 1 : 0;
+    if (settings.max_cut_steps > 0 && consecutive_cut_steps >= settings.max_cut_steps) break;
     record = NewtonIteration{};
   }
 

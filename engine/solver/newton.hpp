@@ -31,6 +31,12 @@ struct NewtonSettings {
   /// With max_iterations = 0 (a capped step resumed after its last iteration) such a solve
   /// does nothing and returns an empty history.
   bool judge_final_iterate = true;
+  /// > 0: the solve returns, unconverged, after this many consecutive steps whose feasible
+  /// step bound (Objective::max_feasible_step) was below `cut_step`. Such steps creep toward a
+  /// constraint the objective holds too weakly; a caller that can stiffen it (the contact
+  /// barrier's κ) gets control back at once instead of after its whole iteration budget.
+  int max_cut_steps = 0;
+  double cut_step = 0.1;  ///< the feasible step below which a step counts as cut
 };
 
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected

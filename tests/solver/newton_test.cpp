@@ -444,6 +444,35 @@ TEST(Newton, RespectsMaxFeasibleStep) {
     EXPECT_LE((probe.iterates[k] - probe.iterates[k - 1]).lpNorm<Eigen::Infinity>(), 0.25 + 1e-15);
 }
 
+// A caller that can stiffen the constraint cutting its steps gets control back after
+// max_cut_steps steps in a row below cut_step, instead of after the whole budget.
+TEST(Newton, ReturnsAfterConsecutiveCutStepsWhenAsked) {
+  ProbeQuadratic probe(3, -2.0);
+  probe.max_displacement = 0.05;  // every step cut to 0.05 / 2 of the way, then less
+  NewtonSettings settings = tight_settings();
+  settings.max_cut_steps = 3;
+  settings.cut_step = 0.1;
+  const auto [x, result] = run_from_origin(probe, settings);
+  EXPECT_FALSE(result.converged);
+  EXPECT_FALSE(result.stagnated);
+  EXPECT_EQ(result.iterations, 3);
+  EXPECT_NEAR(x[0], -0.15, 1e-12);
+
+  // Without it the same steps run until the budget ends (2 / 0.05 = 40 steps < 60).
+  const ProbeRun whole = run_from_origin(probe, tight_settings());
+  EXPECT_TRUE(whole.result.converged);
+  EXPECT_GE(whole.result.iterations, 40);
+
+  // Cut steps that are not consecutive never end the solve: a full step resets the count.
+  ProbeQuadratic once(3, -2.0);
+  once.max_displacement = 1.0;  // the first step goes half way, the second all the rest
+  settings.max_cut_steps = 2;
+  settings.cut_step = 0.6;
+  const auto [y, alternating] = run_from_origin(once, settings);
+  EXPECT_TRUE(alternating.converged);
+  EXPECT_LT((y.array() + 2.0).abs().maxCoeff(), 1e-12);
+}
+
 // A Hessian 100 times too stiff (as a PSD projection can make it where E is not convex) gives
 // full steps 1/100 of the way: they are extended to α = 64 while E keeps decreasing.
 TEST(Newton, ExtendsFullStepsWhereHessianOverestimatesCurvature) {
@@ -672,6 +701,12 @@ TEST(Newton, RejectsBadSettings) {
   EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
   settings = NewtonSettings{};
   settings.backtracking = 1.0;
+  EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
+  settings = NewtonSettings{};
+  settings.max_cut_steps = -1;
+  EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
+  settings = NewtonSettings{};
+  settings.cut_step = 0.0;
   EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
 }
 
