@@ -29,6 +29,11 @@ using Gradient12 = Eigen::Matrix<double, 12, 1>;
 /// with the candidates within reach + 2 r_max. See docs/contact.md for the measurements.
 constexpr double kMaxCertificateRadius = 16.0;
 
+/// The skin s of a CCD query's candidate search, in reaches: the search covers every vertex
+/// within s of its swept box, so that the next iterations' shorter steps reuse it. See
+/// docs/contact.md for the measurements.
+constexpr double kSearchSkin = 1.0;
+
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }
 
 /// m(c) b(d − ξ²) of one pair (m = 1 for point–triangle), +∞ within the thickness.
@@ -189,7 +194,8 @@ ContactStats& ContactStats::operator+=(const ContactStats& other) {
   barrier_certified += other.barrier_certified;
   ccd_certified += other.ccd_certified;
   certificate_renewals += other.certificate_renewals;
-  motion_reuses += other.motion_reuses;
+  state_reuses += other.state_reuses;
+  ccd_reuses += other.ccd_reuses;
   max_active_pairs = std::max(max_active_pairs, other.max_active_pairs);
   broad_phase_seconds += other.broad_phase_seconds;
   barrier_seconds += other.barrier_seconds;
@@ -219,7 +225,7 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
   min_distance_ = kInfinity;
   cached_x_ = x;
   ContactCandidates searched;
-  const ContactCandidates* candidates = &searched_motion_.candidates;
+  const ContactCandidates* candidates = &searched_.candidates;
   {
     ScopedTimer timer(stats_.broad_phase_seconds);
     if (parameters_.skip_when_apart && certificate_.covers(x)) {
@@ -231,8 +237,8 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
       ++stats_.barrier_skips;
       return;
     }
-    if (searched_motion_.contains(x)) {
-      ++stats_.motion_reuses;
+    if (searched_.contains(as_positions(x))) {
+      ++stats_.state_reuses;
     } else {
       searched = broad_phase_.distance_candidates(as_positions(x), reach());
       candidates = &searched;
@@ -260,12 +266,28 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
   stats_.max_active_pairs = std::max(stats_.max_active_pairs, static_cast<long>(active_.size()));
 }
 
-bool ContactPotential::SearchedMotion::contains(const Eigen::VectorXd& x) const {
-  if (motion.size() != x.size()) return false;
-  const Eigen::VectorXd offset = x - start;
-  const double length = motion.squaredNorm();
-  const double t = length > 0 ? std::clamp(offset.dot(motion) / length, 0.0, 1.0) : 0.0;
-  return (offset - t * motion).lpNorm<Eigen::Infinity>() <= tolerance;
+bool ContactPotential::SearchedRegion::contains(const Positions& x) const {
+  return x.rows() == lower.rows() && (x.array() >= lower.array()).all() &&
+         (x.array() <= upper.array()).all();
+}
+
+const ContactCandidates& ContactPotential::swept_candidates(const Positions& start,
+                                                            const Positions& end) {
+  if (searched_.contains(start) && searched_.contains(end)) {
+    ++stats_.ccd_reuses;
+    return searched_.candidates;
+  }
+  // The boxes are rounded outward by τ (distance_rounding_margin) on top of the skin, and the
+  // search's reach by 2τ, so that a vertex in its box lies within s of its searched box
+  // whatever the rounding of the box's bounds.
+  const double skin = kSearchSkin * reach();
+  const double tolerance = distance_rounding_margin(
+      std::max(start.cwiseAbs().maxCoeff(), end.cwiseAbs().maxCoeff()) + skin);
+  searched_.lower = (start.cwiseMin(end).array() - (skin + tolerance)).matrix();
+  searched_.upper = (start.cwiseMax(end).array() + (skin + tolerance)).matrix();
+  searched_.candidates =
+      broad_phase_.swept_candidates(start, end, reach() + 2 * (skin + 2 * tolerance));
+  return searched_.candidates;
 }
 
 bool ContactPotential::renew_certificate(const Eigen::VectorXd& x) {
@@ -365,16 +387,9 @@ double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen
     ++stats_.ccd_skips;
     return 1.0;
   }
-  // A state on the motion lies within rounding (the tolerance) of a point of it, and each box
-  // of a pair moves at most that far per axis: the slack of 2 tolerances keeps its pairs found.
-  SearchedMotion& searched = searched_motion_;
-  searched.tolerance = distance_rounding_margin(
-      std::max(start.cwiseAbs().maxCoeff(), end.cwiseAbs().maxCoeff()));
-  searched.candidates = broad_phase_.swept_candidates(start, end, reach() + 2 * searched.tolerance);
-  searched.start = x;
-  searched.motion = dx;
-  stats_.ccd_pair_queries += static_cast<long>(searched.candidates.size());
-  return smallest_time_of_impact(candidate_pairs(searched.candidates, broad_phase_), x, x + dx,
+  const ContactCandidates& candidates = swept_candidates(start, end);
+  stats_.ccd_pair_queries += static_cast<long>(candidates.size());
+  return smallest_time_of_impact(candidate_pairs(candidates, broad_phase_), x, x + dx,
                                  parameters_.ccd);
 }
 

@@ -62,7 +62,8 @@ struct ContactStats {
   long barrier_certified = 0;      ///< of the barrier skips, those the certificate answered
   long ccd_certified = 0;          ///< of the CCD skips, those the certificate answered
   long certificate_renewals = 0;   ///< clearance queries that issued a certificate
-  long motion_reuses = 0;          ///< states whose candidates the last CCD query's search gave
+  long state_reuses = 0;           ///< states whose candidates the kept CCD search gave
+  long ccd_reuses = 0;             ///< CCD queries whose candidates the kept CCD search gave
   long max_active_pairs = 0;       ///< the most pairs within reach at one state
   double broad_phase_seconds = 0;  ///< early-outs and candidate searches of the barrier
   double barrier_seconds = 0;      ///< distances, barrier values and derivatives
@@ -135,9 +136,10 @@ class ContactPotential {
   /// The largest α ≤ 1 such that the linear motion x → x + α dx keeps every pair farther
   /// apart than ξ: the minimum additive-CCD time of impact over the swept candidates (each
   /// already conservative: the gap keeps at least ccd.ratio_bound of its start value).
-  /// The candidates are searched within reach of the motion and kept: every state on it (the
-  /// line search's trials, the accepted iterate) then finds its pairs among them instead of
-  /// searching the whole surface again, so a Newton iteration pays for one search.
+  /// The candidates are searched within reach + 2s of the motion (the skin s is one reach,
+  /// docs/contact.md) and kept: every later state or motion within s of the swept boxes (the line search's
+  /// trials, the accepted iterate, the next iterations' short steps) then finds its pairs among
+  /// them instead of searching the whole surface again.
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx);
 
   /// The clearance certificate of the skips (radius < 0 while there is none).
@@ -147,18 +149,21 @@ class ContactPotential {
   void reset_stats() { stats_ = ContactStats{}; }
 
  private:
-  /// The last CCD query's motion start → start + motion, with its swept candidates within
-  /// reach + 2 tolerance.
-  struct SearchedMotion {
-    Eigen::VectorXd start;
-    Eigen::VectorXd motion;
-    double tolerance = 0;
+  /// The region the last candidate search of a CCD query covered: per vertex, the box its
+  /// motion swept, grown by a skin s on every side; and the candidates within reach + 2s of
+  /// the unskinned boxes. A later state or motion whose every vertex stays in its box has
+  /// every pair within reach among them (each box of a pair lies within s of a searched one).
+  struct SearchedRegion {
+    Positions lower, upper;
     ContactCandidates candidates;
 
-    /// Whether x lies on the motion to within the tolerance (the rounding of start + α motion,
-    /// which the search's slack covers), so that the candidates hold every pair within reach at x.
-    [[nodiscard]] bool contains(const Eigen::VectorXd& x) const;
+    /// Whether every vertex of x lies in its box.
+    [[nodiscard]] bool contains(const Positions& x) const;
   };
+
+  /// Candidates for the motion start → end: the searched region's when it contains both ends
+  /// (its boxes are convex, so the whole motion), else a new search that becomes the region.
+  const ContactCandidates& swept_candidates(const Positions& start, const Positions& end);
 
   void refresh(const Eigen::VectorXd& x);
   bool renew_certificate(const Eigen::VectorXd& x);
@@ -174,7 +179,7 @@ class ContactPotential {
   std::vector<ContactPair> active_;
   double min_distance_ = 0;
   ClearanceCertificate certificate_;
-  SearchedMotion searched_motion_;
+  SearchedRegion searched_;
 };
 
 }  // namespace psq

@@ -345,16 +345,22 @@ TEST(ContactPotential, SkipsChangeNothingAlongRandomMotions) {
       with_skips.ccd_certified, with_skips.ccd_evaluations, longer_steps);
 }
 
-TEST(ContactPotential, StatesOnTheLastCcdMotionFindThePairsOfAFreshSearch) {
-  // The sheets approach from 4 d̂ to within reach along one CCD query's motion; every state on
-  // it (computed as x + α dx, with its rounding) must see the pairs a fresh search sees, and a
-  // state off the motion must be searched again.
+TEST(ContactPotential, StatesAndMotionsWithinTheSearchedRegionFindThePairsOfAFreshSearch) {
+  // The sheets approach from 4 d̂ to within reach along one CCD query's motion. Every state on
+  // it (computed as x + α dx, with its rounding), and every state or motion that stays within
+  // the search's skin (d̂ here: reach = d̂) of its swept boxes, must see the pairs and the time
+  // of impact that a fresh potential sees; anything farther must be searched again.
   std::mt19937 rng(17);
   TwoSheets sheets = two_sheets(4 * kActivation);
   for (Eigen::Index i = 2; i < sheets.x.size(); i += 3)
     sheets.x[i] += 0.3 * kActivation * test::random_point(rng).z();
   ContactPotential reusing(sheets.surface, parameters(false));
-  ContactPotential searching(sheets.surface, parameters(false));
+  const auto fresh_pairs = [&](const Eigen::VectorXd& x) {
+    return ContactPotential(sheets.surface, parameters(false)).active_pairs(x);
+  };
+  const auto fresh_step = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {
+    return ContactPotential(sheets.surface, parameters(false)).max_feasible_step(x, dx);
+  };
   const Eigen::VectorXd dx = upper_moved(sheets, {0.0, 0.0, -3.6 * kActivation}) - sheets.x +
                              random_motion(sheets.x.size(), 0.1 * kActivation, rng);
   const double alpha = reusing.max_feasible_step(sheets.x, dx);
@@ -362,18 +368,34 @@ TEST(ContactPotential, StatesOnTheLastCcdMotionFindThePairsOfAFreshSearch) {
   std::size_t most_pairs = 0;
   for (const double t : {0.0, 0.25, 0.5, 0.75, 0.9, 1.0}) {
     const Eigen::VectorXd x = sheets.x + t * alpha * dx;
-    expect_same_pairs(reusing.active_pairs(x), searching.active_pairs(x));
-    most_pairs = std::max(most_pairs, searching.active_pairs(x).size());
+    expect_same_pairs(reusing.active_pairs(x), fresh_pairs(x));
+    most_pairs = std::max(most_pairs, fresh_pairs(x).size());
   }
   EXPECT_GT(most_pairs, 0u);
-  EXPECT_EQ(reusing.stats().motion_reuses, 6);
+  EXPECT_EQ(reusing.stats().state_reuses, 6);
+  EXPECT_EQ(reusing.stats().ccd_reuses, 0);
 
-  // Sideways by a tenth of d̂: no longer on the motion.
-  const Eigen::VectorXd off = sheets.x + alpha * dx + upper_moved(sheets, {1e-4, 0.0, 0.0}) -
-                              sheets.x;
-  expect_same_pairs(reusing.active_pairs(off), searching.active_pairs(off));
-  EXPECT_EQ(reusing.stats().motion_reuses, 6);
-  EXPECT_EQ(searching.stats().motion_reuses, 0);
+  // A short motion 2 d̂ apart and 5 d̂ aside (beyond the skin: a new search), then a state
+  // 0.9 d̂ closer, within the skin: pairs whose boxes were up to 1.8 d̂ beyond reach during the
+  // motion come within reach, and the search's slack kept them. A short motion from there
+  // reuses the candidates and finds the same time of impact.
+  const Eigen::VectorXd apart = upper_moved(sheets, {5 * kActivation, 0.0, -2 * kActivation});
+  const Eigen::VectorXd nudge = random_motion(sheets.x.size(), 0.05 * kActivation, rng);
+  EXPECT_EQ(reusing.max_feasible_step(apart, nudge), fresh_step(apart, nudge));
+  EXPECT_EQ(reusing.stats().ccd_reuses, 0);
+  const Eigen::VectorXd closer = upper_moved(sheets, {5 * kActivation, 0.0, -2.9 * kActivation});
+  expect_same_pairs(reusing.active_pairs(closer), fresh_pairs(closer));
+  EXPECT_GT(fresh_pairs(closer).size(), 0u);
+  EXPECT_EQ(reusing.stats().state_reuses, 7);
+  EXPECT_EQ(reusing.max_feasible_step(closer, nudge), fresh_step(closer, nudge));
+  EXPECT_EQ(reusing.stats().ccd_reuses, 1);
+
+  // 3 d̂ farther aside, beyond the skin: searched again.
+  const Eigen::VectorXd far = upper_moved(sheets, {8 * kActivation, 0.0, -2.9 * kActivation});
+  expect_same_pairs(reusing.active_pairs(far), fresh_pairs(far));
+  EXPECT_EQ(reusing.stats().state_reuses, 7);
+  EXPECT_EQ(reusing.max_feasible_step(far, nudge), fresh_step(far, nudge));
+  EXPECT_EQ(reusing.stats().ccd_reuses, 1);
 }
 
 TEST(ContactPotential, RejectsBadParameters) {
