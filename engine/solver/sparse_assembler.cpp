@@ -1,7 +1,10 @@
 #include "engine/solver/sparse_assembler.hpp"
 
-#include <algorithm>
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <stdexcept>
 
 namespace psq {
@@ -101,22 +104,29 @@ bool SparseAssembler::assemble(const HessianBlocks& blocks, const DofMap& dofs) 
   bool pattern_changed = false;
   if (rebuild_count_ == 0 || !stencils_match(blocks, dofs)) {
     pattern_changed = rebuild_pattern(blocks, dofs) || rebuild_count_ == 0;
-    rebuild_scatter_map(blocks, dofs);
+    rebuild_scatter_map(blocks, dofs, pattern_changed);
     ++rebuild_count_;
   }
   scatter(blocks);
   return pattern_changed;
 }
 
-bool SparseAssembler::stencils_match(const HessianBlocks& blocks, const DofMap& dofs) const {
+bool SparseAssembler::dofs_match(const DofMap& dofs) const {
   if (static_cast<Eigen::Index>(reduced_.size()) != dofs.full_size()) return false;
   for (std::size_t i = 0; i < reduced_.size(); ++i)
     if (reduced_[i] != dofs.reduced(static_cast<Eigen::Index>(i))) return false;
-  if (blocks.batches.size() != batches_.size()) return false;
+  return true;
+}
+
+bool SparseAssembler::batch_matches(std::size_t b, const ElementMatrices& batch) const {
+  return b < batches_.size() && batch.stencil_size == batches_[b].stencil_size &&
+         batch.vertices == batches_[b].vertices;
+}
+
+bool SparseAssembler::stencils_match(const HessianBlocks& blocks, const DofMap& dofs) const {
+  if (!dofs_match(dofs) || blocks.batches.size() != batches_.size()) return false;
   for (std::size_t b = 0; b < batches_.size(); ++b)
-    if (blocks.batches[b].stencil_size != batches_[b].stencil_size ||
-        blocks.batches[b].vertices != batches_[b].vertices)
-      return false;
+    if (!batch_matches(b, blocks.batches[b])) return false;
   return true;
 }
 
@@ -161,7 +171,9 @@ bool SparseAssembler::rebuild_pattern(const HessianBlocks& blocks, const DofMap&
   return true;
 }
 
-void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs) {
+void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs,
+                                          bool pattern_changed) {
+  const bool slots_kept = !pattern_changed && dofs_match(dofs);
   reduced_.resize(static_cast<std::size_t>(dofs.full_size()));
   diagonal_slots_.resize(reduced_.size());
   for (std::size_t i = 0; i < reduced_.size(); ++i) {
@@ -173,6 +185,7 @@ void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const Dof
   batches_.resize(blocks.batches.size());
   for (std::size_t b = 0; b < batches_.size(); ++b) {
     const ElementMatrices& batch = blocks.batches[b];
+    if (slots_kept && batch_matches(b, batch)) continue;
     BatchMap& map = batches_[b];
     map.stencil_size = batch.stencil_size;
     map.vertices = batch.vertices;
@@ -180,23 +193,38 @@ void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const Dof
     const int m = batch.dofs_per_element();
     const std::size_t upper_size = static_cast<std::size_t>(m) * (m + 1) / 2;
     map.slots.resize(batch.element_count() * upper_size);
-    std::vector<int> local(m);
-    int* slot = map.slots.data();
-    for (std::size_t e = 0; e < batch.element_count(); ++e) {
+    const auto local_dofs = [&](std::size_t e, std::vector<int>& local) {
       for (int k = 0; k < m; ++k)
         local[k] = reduced_[3 * batch.vertices[e * batch.stencil_size + k / 3] + k % 3];
+    };
+    // Each element fills its own slots: the lookups run in parallel. (A pattern change, as
+    // contact pairs come and go, redoes them for every element of every batch.)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.element_count(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        std::vector<int> local(m);
+                        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+                          local_dofs(e, local);
+                          int* slot = map.slots.data() + e * upper_size;
+                          for (int j = 0; j < m; ++j)
+                            for (int i = 0; i <= j; ++i, ++slot) {
+                              const int ri = local[i];
+                              const int rj = local[j];
+                              *slot = (ri < 0 || rj < 0) ? -1
+                                                         : find_slot(matrix_, std::min(ri, rj),
+                                                                     std::max(ri, rj));
+                            }
+                        }
+                      });
+    // In element order, so that the scatter sums them in the same order on every run.
+    std::vector<int> local(m);
+    for (std::size_t e = 0; e < batch.element_count(); ++e) {
+      local_dofs(e, local);
+      const int* slot = map.slots.data() + e * upper_size;
       for (int j = 0; j < m; ++j)
-        for (int i = 0; i <= j; ++i) {
-          const int ri = local[i];
-          const int rj = local[j];
-          *slot = (ri < 0 || rj < 0) ? -1
-                                     : find_slot(matrix_, std::min(ri, rj), std::max(ri, rj));
-          if (i < j && ri == rj && ri >= 0) {
-            const std::size_t mirror = e * batch.block_size() + static_cast<std::size_t>(i) * m + j;
-            map.mirrored.emplace_back(mirror, *slot);
-          }
-          ++slot;
-        }
+        for (int i = 0; i <= j; ++i, ++slot)
+          if (i < j && local[i] == local[j] && local[i] >= 0)
+            map.mirrored.emplace_back(
+                e * batch.block_size() + static_cast<std::size_t>(i) * m + j, *slot);
     }
   }
 }

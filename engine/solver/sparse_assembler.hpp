@@ -46,9 +46,13 @@ class SparseAssembler {
   };
 
   [[nodiscard]] bool stencils_match(const HessianBlocks& blocks, const DofMap& dofs) const;
+  [[nodiscard]] bool dofs_match(const DofMap& dofs) const;
+  [[nodiscard]] bool batch_matches(std::size_t b, const ElementMatrices& batch) const;
   /// Builds the pattern; returns true when it differs from the current one.
   bool rebuild_pattern(const HessianBlocks& blocks, const DofMap& dofs);
-  void rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs);
+  /// Rebuilds the scatter maps; with `pattern_changed` false and the same DOF map, only those
+  /// of batches whose stencils changed (their slots in an unchanged pattern are the same).
+  void rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs, bool pattern_changed);
   void scatter(const HessianBlocks& blocks);
 
   Eigen::SparseMatrix<double> matrix_;
