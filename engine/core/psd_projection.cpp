@@ -3,13 +3,22 @@
 #include <Eigen/Eigenvalues>
 
 namespace psq {
+namespace {
 
-void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric) {
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(symmetric);
-  const Eigen::VectorXd& lambda = eig.eigenvalues();
+template <class Symmetric>
+void clamp_negative_eigenvalues(Symmetric& symmetric) {
+  Eigen::SelfAdjointEigenSolver<typename Symmetric::PlainObject> eig(symmetric);
+  const auto& lambda = eig.eigenvalues();
   if (lambda.minCoeff() >= 0.0) return;
-  const Eigen::VectorXd clamped = lambda.cwiseMax(0.0);
-  symmetric = eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+  symmetric = eig.eigenvectors() * lambda.cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+}
+
+}  // namespace
+
+void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric) { clamp_negative_eigenvalues(symmetric); }
+
+void project_to_psd(Eigen::Matrix<double, 12, 12>& symmetric) {
+  clamp_negative_eigenvalues(symmetric);
 }
 
 }  // namespace psq

@@ -24,5 +24,17 @@ TEST(PsdProjection, LeavesPositiveSemiDefiniteMatricesUnchanged) {
   EXPECT_EQ(m, before);
 }
 
+TEST(PsdProjection, FixedSizeBlocksProjectLikeDynamicOnes) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(12, 12);
+  Eigen::Matrix<double, 12, 12> fixed = a + a.transpose();
+  Eigen::MatrixXd dynamic = fixed;
+  ASSERT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dynamic).eigenvalues().minCoeff(), 0.0);
+  project_to_psd(fixed);
+  project_to_psd(dynamic);
+  EXPECT_LT((fixed - dynamic).norm(), 1e-12 * dynamic.norm());
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(fixed)).eigenvalues().minCoeff(),
+            -1e-12 * dynamic.norm());
+}
+
 }  // namespace
 }  // namespace psq
