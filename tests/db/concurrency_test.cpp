@@ -193,13 +193,16 @@ TEST(JobStoreCrash, JobOfAKilledWorkerIsReclaimedAfterItsLeaseExpires) {
 TEST(JobStoreCrash, WorkersKilledAtRandomMomentsLeaveASoundStore) {
   const auto dir = psq::test::fresh_temp_dir("db-random-kill");
   const auto path = dir / "psq.db";
-  constexpr int kJobs = 150;
+  // Rounds go on until enough workers died mid-work; on a fast machine 150 jobs were all done
+  // after 8 kills, so there are enough jobs for the kills not to run out of work.
+  constexpr int kJobs = 400;
+  constexpr int kWantedKills = 12;
   { JobStore(path).add_sweep("s", "s.toml", thickness_jobs(0, kJobs, 3, /*max_attempts=*/1000)); }
 
   std::mt19937 random(20240607);
   std::uniform_int_distribution<int> delay_us(0, 30000);
   int killed = 0;
-  for (int round = 0; round < 40; ++round) {
+  for (int round = 0; round < 200 && killed < kWantedKills; ++round) {
     std::vector<ChildProcess> workers;
     for (int w = 0; w < 2; ++w) {
       const std::string id = fmt::format("r{}w{}", round, w);
@@ -216,7 +219,7 @@ TEST(JobStoreCrash, WorkersKilledAtRandomMomentsLeaveASoundStore) {
       else EXPECT_TRUE(exited_cleanly(status));
     }
   }
-  EXPECT_GE(killed, 10) << "too few workers were killed for the test to mean anything";
+  EXPECT_GE(killed, kWantedKills) << "too few workers were killed for the test to mean anything";
 
   ManualClock later{wall_clock() + 3600};  // every lease of a killed worker has expired
   JobStore store(path, later.options());
