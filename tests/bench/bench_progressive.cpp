@@ -7,11 +7,15 @@
 // the level-0 vertices and prolonged (about the best the level-0 space can hold); and, without
 // the prolongation, the preview's and the direct coarse answer's distances at the level-0
 // vertices to that sample. Targets (issue 4): level-0 preview ≥ 50× faster than the direct fine
-// solve; progressive total faster than the direct fine solve.
+// solve; progressive total faster than the direct fine solve. The contact scenes (drape_sphere,
+// twist_wrap, cylinder_crush; their generated colliders refined with the shell) also print each
+// refinement's safe initialization by phase; targets (issue 13): safe initialization below 10 %
+// of its level's solve, progressive total ≥ 3× faster than the direct fine solve on the
+// twisting and crushing scenes.
 //
 // Usage: bench_progressive [--vertices N] [--levels L] [--frames F] [--gradient exact|held]
 //                          [--preview-tolerance T] [--preview-iterations K]
-//                          [--scenes drape,twist,cylinder_compress]
+//                          [--scenes drape,twist,cylinder_compress,drape_sphere,...]
 //                          [--preview-only 1]   (level 0 only, no direct solves)
 //                          [--direct 0]         (all levels, no direct solves or errors)
 
@@ -39,8 +43,17 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The library scene with its mesh's edge length set for about `vertices` vertices
-/// (near-equilateral triangles: 2/(√3 e²) vertices per unit area).
+/// The edge length of a generated mesh (sheet, cylinder or sphere; not for a mesh file).
+double& generated_edge_length(psq::MeshSource& mesh) {
+  if (mesh.kind == psq::MeshSource::Kind::Cylinder) return mesh.cylinder.edge_length;
+  if (mesh.kind == psq::MeshSource::Kind::Sphere) return mesh.sphere.edge_length;
+  return mesh.sheet.edge_length;
+}
+
+/// The library scene with its shell's edge length set for about `vertices` vertices
+/// (near-equilateral triangles: 2/(√3 e²) vertices per unit area), and generated colliders
+/// refined by the same factor, so that contact resolves the shell's folds as at the scene's
+/// own size.
 psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
   psq::Scene scene = psq::read_scene(PSQ_SOURCE_DIR "/jobs/scenes/" + name + ".toml");
   psq::MeshSource& mesh = scene.shells.at(0).mesh;
@@ -48,7 +61,11 @@ psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
                           ? 2 * M_PI * mesh.cylinder.radius * mesh.cylinder.height
                           : mesh.sheet.width * mesh.sheet.height;
   const double edge = std::sqrt(area * 2 / (std::sqrt(3.0) * vertices));
+  const double refinement = edge / generated_edge_length(mesh);
   mesh.sheet.edge_length = mesh.cylinder.edge_length = edge;
+  for (psq::Collider& collider : scene.colliders)
+    if (collider.mesh.kind != psq::MeshSource::Kind::File)
+      generated_edge_length(collider.mesh) *= refinement;
   scene.time.step *= double(scene.time.frames) / frames;
   scene.time.frames = frames;
   return scene;
@@ -96,6 +113,12 @@ Sample sample_at(const psq::TriMesh& rest, const psq::Positions& deformed,
   return result;
 }
 
+/// The first shell's part of a system's flat positions (shells come first, then colliders):
+/// the errors compare the shell alone.
+Eigen::VectorXd shell_part(const Eigen::VectorXd& x, const psq::TriMesh& shell) {
+  return x.head(3 * shell.vertex_count());
+}
+
 void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings,
                bool preview_only, bool direct_solves) {
   auto start = Clock::now();
@@ -133,12 +156,25 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
         sim.level_converged() ? "" : " (NOT converged)", phases.assembly, phases.factorization,
         phases.solve, phases.line_search, shifted, reanalyzed);
     if (sim.level() == 0) {
-      preview = sim.finest_positions();
-      preview_level0 = sim.positions();
+      preview = shell_part(sim.finest_positions(), sim.hierarchies().at(0).levels.back().rest);
+      preview_level0 = shell_part(sim.positions(), sim.hierarchies().at(0).levels[0].rest);
       preview_seconds = level_seconds;
     }
     if (sim.finished() || preview_only) break;
+    start = Clock::now();
     sim.refine();
+    const double refine_seconds = seconds_since(start);
+    total_seconds += refine_seconds;
+    std::cout << fmt::format("  refinement into level {}: {:.2f} s", sim.level(), refine_seconds);
+    if (!sim.refinements().empty() && sim.refinements().back().level == sim.level()) {
+      const psq::RefinementStats& r = sim.refinements().back();
+      std::cout << fmt::format(
+          " [safe initialization {:.2f} s: gap {:.2f}, perturbation {:.2f}, CCD advance {:.2f} "
+          "({} rounds), relaxation {:.2f}, exact check {:.2f} s; {} batches]",
+          r.seconds, r.gap_seconds, r.perturb_seconds, r.ccd_seconds, r.ccd_rounds,
+          r.relax_seconds, r.check_seconds, r.batches);
+    }
+    std::cout << "\n";
   }
 
   if (preview_only || !direct_solves) {
@@ -157,19 +193,22 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
   const psq::test::DirectRun direct_coarse =
       psq::test::settled_direct_run(coarse, sim.finest_tolerance());
   const double coarse_seconds = seconds_since(start);
+  const psq::TriMesh& fine_shell = h.levels.back().rest;
   const psq::ShellProlongation to_finest(h.levels[0].rest, h.levels[0].finest,
-                                         fine.rest_mesh().vertices);
+                                         fine_shell.vertices);
+  const Eigen::VectorXd direct_coarse_shell = shell_part(direct_coarse.positions, h.levels[0].rest);
+  const Eigen::VectorXd direct_shell = shell_part(direct.positions, fine_shell);
   const Eigen::VectorXd coarse_prolonged =
-      psq::flat(to_finest.apply(psq::as_positions(direct_coarse.positions)));
+      psq::flat(to_finest.apply(psq::as_positions(direct_coarse_shell)));
 
   // What the level-0 space can hold at best, roughly: the direct fine answer sampled at the
   // level-0 rest vertices (each at its closest point on the fine rest mesh), prolonged by P^0.
-  const Sample sample = sample_at(fine.rest_mesh(), psq::as_positions(direct.positions),
+  const Sample sample = sample_at(fine_shell, psq::as_positions(direct_shell),
                                   h.levels[0].rest.vertices);
   const Eigen::VectorXd sampled = psq::flat(sample.values);
   const Eigen::VectorXd sampled_prolonged = psq::flat(to_finest.apply(sample.values));
 
-  const double diagonal = psq::bounding_box_diagonal(fine.rest_mesh().vertices);
+  const double diagonal = psq::bounding_box_diagonal(fine_shell.vertices);
   const auto errors = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& reference) {
     return fmt::format("{:.2e} ({:.2e})",
                        psq::test::max_vertex_distance(x, reference) / diagonal,
@@ -185,11 +224,11 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       "rest vertices lie up to {:.1e} off the fine rest mesh: the samples are exact only at 0)\n",
       direct.newton_iterations, direct_seconds, direct.settled ? "" : " (NOT settled)",
       coarse_seconds, preview_seconds, direct_seconds / preview_seconds, total_seconds,
-      total_seconds / direct_seconds, errors(sim.positions(), direct.positions),
-      errors(preview, direct.positions), errors(coarse_prolonged, direct.positions),
-      errors(sampled_prolonged, direct.positions),
+      total_seconds / direct_seconds, errors(shell_part(sim.positions(), fine_shell), direct_shell),
+      errors(preview, direct_shell), errors(coarse_prolonged, direct_shell),
+      errors(sampled_prolonged, direct_shell),
       // Without the prolongation's interpolation error: at the level-0 vertices, to the sample.
-      errors(preview_level0, sampled), errors(direct_coarse.positions, sampled),
+      errors(preview_level0, sampled), errors(direct_coarse_shell, sampled),
       sample.largest_distance / diagonal);
 }
 
