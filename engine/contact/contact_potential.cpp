@@ -254,11 +254,14 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
       ++stats_.barrier_certified;
       return;
     }
-    if (parameters_.skip_when_apart && last_apart && renew_certificate(x)) {
+    // Inside the kept region the candidates answer at once; a clearance query (a search 33
+    // reaches wide) would cost more.
+    const bool kept = searched_.contains(as_positions(x));
+    if (parameters_.skip_when_apart && last_apart && !kept && renew_certificate(x)) {
       ++stats_.barrier_skips;
       return;
     }
-    if (searched_.contains(as_positions(x))) {
+    if (kept) {
       ++stats_.state_reuses;
     } else {
       searched = broad_phase_.distance_candidates(as_positions(x), reach());
