@@ -35,6 +35,13 @@ int find_slot(const Eigen::SparseMatrix<double>& pattern, int row, int col) {
   return static_cast<int>(std::lower_bound(first, last, row) - inner);
 }
 
+bool repeats_a_vertex(const int* stencil, int size) {
+  for (int a = 0; a < size; ++a)
+    for (int b = a + 1; b < size; ++b)
+      if (stencil[a] == stencil[b]) return true;
+  return false;
+}
+
 bool has_free_dof(const DofMap& dofs, int vertex) {
   return dofs.reduced(3 * vertex) >= 0 || dofs.reduced(3 * vertex + 1) >= 0 ||
          dofs.reduced(3 * vertex + 2) >= 0;
@@ -183,50 +190,52 @@ void SparseAssembler::rebuild_scatter_map(const HessianBlocks& blocks, const Dof
   }
 
   batches_.resize(blocks.batches.size());
-  for (std::size_t b = 0; b < batches_.size(); ++b) {
-    const ElementMatrices& batch = blocks.batches[b];
-    if (slots_kept && batch_matches(b, batch)) continue;
-    BatchMap& map = batches_[b];
-    map.stencil_size = batch.stencil_size;
-    map.vertices = batch.vertices;
-    map.mirrored.clear();
-    const int m = batch.dofs_per_element();
-    const std::size_t upper_size = static_cast<std::size_t>(m) * (m + 1) / 2;
-    map.slots.resize(batch.element_count() * upper_size);
-    const auto local_dofs = [&](std::size_t e, std::vector<int>& local) {
-      for (int k = 0; k < m; ++k)
-        local[k] = reduced_[3 * batch.vertices[e * batch.stencil_size + k / 3] + k % 3];
-    };
-    // Each element fills its own slots: the lookups run in parallel. (A pattern change, as
-    // contact pairs come and go, redoes them for every element of every batch.)
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.element_count(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        std::vector<int> local(m);
-                        for (std::size_t e = range.begin(); e != range.end(); ++e) {
-                          local_dofs(e, local);
-                          int* slot = map.slots.data() + e * upper_size;
-                          for (int j = 0; j < m; ++j)
-                            for (int i = 0; i <= j; ++i, ++slot) {
-                              const int ri = local[i];
-                              const int rj = local[j];
-                              *slot = (ri < 0 || rj < 0) ? -1
-                                                         : find_slot(matrix_, std::min(ri, rj),
-                                                                     std::max(ri, rj));
-                            }
-                        }
-                      });
-    // In element order, so that the scatter sums them in the same order on every run.
-    std::vector<int> local(m);
-    for (std::size_t e = 0; e < batch.element_count(); ++e) {
-      local_dofs(e, local);
-      const int* slot = map.slots.data() + e * upper_size;
-      for (int j = 0; j < m; ++j)
-        for (int i = 0; i <= j; ++i, ++slot)
-          if (i < j && local[i] == local[j] && local[i] >= 0)
-            map.mirrored.emplace_back(
-                e * batch.block_size() + static_cast<std::size_t>(i) * m + j, *slot);
-    }
+  for (std::size_t b = 0; b < batches_.size(); ++b)
+    if (!(slots_kept && batch_matches(b, blocks.batches[b])))
+      rebuild_batch_map(blocks.batches[b], batches_[b]);
+}
+
+void SparseAssembler::rebuild_batch_map(const ElementMatrices& batch, BatchMap& map) const {
+  map.stencil_size = batch.stencil_size;
+  map.vertices = batch.vertices;
+  map.mirrored.clear();
+  const int m = batch.dofs_per_element();
+  const std::size_t upper_size = static_cast<std::size_t>(m) * (m + 1) / 2;
+  map.slots.resize(batch.element_count() * upper_size);
+  const auto local_dofs = [&](std::size_t e, std::vector<int>& local) {
+    for (int k = 0; k < m; ++k)
+      local[k] = reduced_[3 * batch.vertices[e * batch.stencil_size + k / 3] + k % 3];
+  };
+  // Each element fills its own slots, so the lookups run in parallel: a pattern change, as
+  // contact pairs come and go, redoes them for every element of every batch.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.element_count(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<int> local(m);
+                      for (std::size_t e = range.begin(); e != range.end(); ++e) {
+                        local_dofs(e, local);
+                        int* slot = map.slots.data() + e * upper_size;
+                        for (int j = 0; j < m; ++j)
+                          for (int i = 0; i <= j; ++i) *slot++ = upper_slot(local[i], local[j]);
+                      }
+                    });
+  // Two local DOFs coincide only where the stencil lists a vertex twice. In element order, so
+  // that the scatter sums them in the same order on every run.
+  std::vector<int> local(m);
+  for (std::size_t e = 0; e < batch.element_count(); ++e) {
+    if (!repeats_a_vertex(batch.vertices.data() + e * batch.stencil_size, batch.stencil_size))
+      continue;
+    local_dofs(e, local);
+    const int* slot = map.slots.data() + e * upper_size;
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i <= j; ++i, ++slot)
+        if (i < j && local[i] == local[j] && local[i] >= 0)
+          map.mirrored.emplace_back(e * batch.block_size() + static_cast<std::size_t>(i) * m + j,
+                                    *slot);
   }
+}
+
+int SparseAssembler::upper_slot(int row, int col) const {
+  return row < 0 || col < 0 ? -1 : find_slot(matrix_, std::min(row, col), std::max(row, col));
 }
 
 void SparseAssembler::scatter(const HessianBlocks& blocks) {
