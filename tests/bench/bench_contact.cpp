@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bench/bench_options.hpp"
+#include "bench/generated_mesh.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "engine/sim/quasistatic.hpp"
 
@@ -44,8 +45,7 @@ const std::vector<Case> kCases = {
 };
 
 void set_edge_length(MeshSource& mesh, double edge) {
-  if (edge <= 0) return;
-  mesh.sheet.edge_length = mesh.cylinder.edge_length = mesh.sphere.edge_length = edge;
+  if (edge > 0) psq::bench::set_generated_edge_length(mesh, edge);
 }
 
 /// The cases named on the command line (all by default), each with its frame count or `frames`.

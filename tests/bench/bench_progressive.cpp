@@ -19,18 +19,18 @@
 //                          [--preview-only 1]   (level 0 only, no direct solves)
 //                          [--direct 0]         (all levels, no direct solves or errors)
 
-#include <fmt/format.h>
-
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
+#include <fmt/format.h>
 
 #include <chrono>
 #include <cmath>
 #include <iostream>
 
 #include "bench/bench_options.hpp"
+#include "bench/generated_mesh.hpp"
 #include "engine/contact/point_triangle_distance.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 #include "engine/scene/scene_reader.hpp"
@@ -41,13 +41,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// The edge length of a generated mesh (sheet, cylinder or sphere; not for a mesh file).
-double& generated_edge_length(psq::MeshSource& mesh) {
-  if (mesh.kind == psq::MeshSource::Kind::Cylinder) return mesh.cylinder.edge_length;
-  if (mesh.kind == psq::MeshSource::Kind::Sphere) return mesh.sphere.edge_length;
-  return mesh.sheet.edge_length;
 }
 
 /// The library scene with its shell's edge length set for about `vertices` vertices
@@ -61,11 +54,12 @@ psq::Scene sized_scene(const std::string& name, int vertices, int frames) {
                           ? 2 * M_PI * mesh.cylinder.radius * mesh.cylinder.height
                           : mesh.sheet.width * mesh.sheet.height;
   const double edge = std::sqrt(area * 2 / (std::sqrt(3.0) * vertices));
-  const double refinement = edge / generated_edge_length(mesh);
-  mesh.sheet.edge_length = mesh.cylinder.edge_length = edge;
+  const double refinement = edge / psq::bench::generated_edge_length(mesh);
+  psq::bench::set_generated_edge_length(mesh, edge);
   for (psq::Collider& collider : scene.colliders)
     if (collider.mesh.kind != psq::MeshSource::Kind::File)
-      generated_edge_length(collider.mesh) *= refinement;
+      psq::bench::set_generated_edge_length(
+          collider.mesh, refinement * psq::bench::generated_edge_length(collider.mesh));
   scene.time.step *= double(scene.time.frames) / frames;
   scene.time.frames = frames;
   return scene;
@@ -171,8 +165,8 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       std::cout << fmt::format(
           " [safe initialization {:.2f} s: gap {:.2f}, perturbation {:.2f}, CCD advance {:.2f} "
           "({} rounds), relaxation {:.2f}, exact check {:.2f} s; {} batches]",
-          r.seconds, r.gap_seconds, r.perturb_seconds, r.ccd_seconds, r.ccd_rounds,
-          r.relax_seconds, r.check_seconds, r.batches);
+          r.seconds, r.gap_seconds, r.perturb_seconds, r.ccd_seconds, r.ccd_rounds, r.relax_seconds,
+          r.check_seconds, r.batches);
     }
     std::cout << "\n";
   }
@@ -194,8 +188,7 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       psq::test::settled_direct_run(coarse, sim.finest_tolerance());
   const double coarse_seconds = seconds_since(start);
   const psq::TriMesh& fine_shell = h.levels.back().rest;
-  const psq::ShellProlongation to_finest(h.levels[0].rest, h.levels[0].finest,
-                                         fine_shell.vertices);
+  const psq::ShellProlongation to_finest(h.levels[0].rest, h.levels[0].finest, fine_shell.vertices);
   const Eigen::VectorXd direct_coarse_shell = shell_part(direct_coarse.positions, h.levels[0].rest);
   const Eigen::VectorXd direct_shell = shell_part(direct.positions, fine_shell);
   const Eigen::VectorXd coarse_prolonged =
@@ -203,8 +196,8 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
 
   // What the level-0 space can hold at best, roughly: the direct fine answer sampled at the
   // level-0 rest vertices (each at its closest point on the fine rest mesh), prolonged by P^0.
-  const Sample sample = sample_at(fine_shell, psq::as_positions(direct_shell),
-                                  h.levels[0].rest.vertices);
+  const Sample sample =
+      sample_at(fine_shell, psq::as_positions(direct_shell), h.levels[0].rest.vertices);
   const Eigen::VectorXd sampled = psq::flat(sample.values);
   const Eigen::VectorXd sampled_prolonged = psq::flat(to_finest.apply(sample.values));
 
