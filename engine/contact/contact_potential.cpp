@@ -30,8 +30,8 @@ using Gradient12 = Eigen::Matrix<double, 12, 1>;
 constexpr double kMaxCertificateRadius = 16.0;
 
 /// The skin s of a CCD query's candidate search, in reaches: the search covers every vertex
-/// within s of its swept box, so that the next iterations' shorter steps reuse it. See
-/// docs/contact.md for the measurements.
+/// within s of its swept box, so that the next iterations' shorter steps reuse it
+/// (docs/contact.md, the trade-off).
 constexpr double kSearchSkin = 1.0;
 
 Eigen::Vector3d vertex_of(const Eigen::VectorXd& x, int v) { return x.segment<3>(3 * v); }

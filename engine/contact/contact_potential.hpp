@@ -137,9 +137,9 @@ class ContactPotential {
   /// apart than ξ: the minimum additive-CCD time of impact over the swept candidates (each
   /// already conservative: the gap keeps at least ccd.ratio_bound of its start value).
   /// The candidates are searched within reach + 2s of the motion (the skin s is one reach,
-  /// docs/contact.md) and kept: every later state or motion within s of the swept boxes (the line search's
-  /// trials, the accepted iterate, the next iterations' short steps) then finds its pairs among
-  /// them instead of searching the whole surface again.
+  /// docs/contact.md) and kept: every later state or motion within s of the swept boxes (the line
+  /// search's trials, the accepted iterate, the next iterations' short steps) then finds its pairs
+  /// among them instead of searching the whole surface again.
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx);
 
   /// The clearance certificate of the skips (radius < 0 while there is none).

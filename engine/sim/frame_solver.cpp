@@ -169,8 +169,8 @@ NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs
   const NewtonSolver::Progress numbered = offset_progress(progress, done);
   NewtonSettings chunk = settings;
   // Only the barrier's κ answers creeping, and only where the CCD alone bounds the steps: with
-  // strain limits the bound may be the limit's, which no κ relaxes (a strain-limited press
-  // then refined into a state the strain correction could not bring back under its limit).
+  // strain limits the bound may be the limit's, which no κ relaxes, and stiffening the barrier
+  // there only changes the path.
   if (contact_ && !strain_limit_) {
     chunk.max_cut_steps = kCreepingRun;
     chunk.cut_step = kCreepingStep;

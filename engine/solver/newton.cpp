@@ -176,7 +176,8 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     if (progress) progress(record);
     if (result.converged || result.stagnated || k == settings.max_iterations) break;
     if (k + 1 == settings.max_iterations && !settings.judge_final_iterate) break;
-    consecutive_cut_steps = record.feasible_step < settings.cut_step ? consecutive_cut_steps + 1 : 0;
+    consecutive_cut_steps =
+        record.feasible_step < settings.cut_step ? consecutive_cut_steps + 1 : 0;
     if (settings.max_cut_steps > 0 && consecutive_cut_steps >= settings.max_cut_steps) break;
     record = NewtonIteration{};
   }

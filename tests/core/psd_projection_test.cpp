@@ -32,7 +32,9 @@ TEST(PsdProjection, FixedSizeBlocksProjectLikeDynamicOnes) {
   project_to_psd(fixed);
   project_to_psd(dynamic);
   EXPECT_LT((fixed - dynamic).norm(), 1e-12 * dynamic.norm());
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(fixed)).eigenvalues().minCoeff(),
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(fixed))
+                .eigenvalues()
+                .minCoeff(),
             -1e-12 * dynamic.norm());
 }
 
