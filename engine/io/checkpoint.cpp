@@ -1,7 +1,5 @@
 #include "engine/io/checkpoint.hpp"
 
-#include "engine/core/atomic_file.hpp"
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -12,11 +10,11 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <utility>
 
+#include "engine/core/atomic_file.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/hdf5_handle.hpp"
 
@@ -28,12 +26,6 @@ constexpr std::string_view format_marker = "psq-checkpoint";
 
 /// The first bytes of every HDF5 file without a user block.
 constexpr std::string_view hdf5_signature = "\x89HDF\r\n\x1a\n";
-
-/// The serial HDF5 library is not thread-safe, and checkpoints may be written from any thread.
-std::mutex& hdf5_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
 
 [[noreturn]] void fail(const std::string& file, std::string_view problem) {
   throw CheckpointError(located_message(file, 0, std::string(problem)));
@@ -345,7 +337,7 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
   try {
     std::uint64_t checksum = 0;
     replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
-      const std::lock_guard lock(hdf5_mutex());
+      const std::lock_guard lock(hdf5::library_mutex());
       encode(checkpoint, temporary);
       // Reading the file back proves that HDF5 wrote all of it: a write it held back and lost
       // without an error (as its dataset buffer once did on a full disk) must not replace the
@@ -376,7 +368,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path,
   if (!std::string_view(bytes.data(), bytes.size()).starts_with(hdf5_signature))
     fail(file_name, "not an HDF5 file (no HDF5 signature at its start)");
   try {
-    const std::lock_guard lock(hdf5_mutex());
+    const std::lock_guard lock(hdf5::library_mutex());
     return decode(file_name, bytes);
   } catch (const hdf5::Hdf5Error& e) {
     throw CheckpointError(

@@ -113,6 +113,11 @@ herr_t collect_attribute_name(hid_t, const char* name, const H5A_info_t*, void* 
 
 }  // namespace
 
+std::mutex& library_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
 Id::Id(Id&& other) noexcept
     : id_(std::exchange(other.id_, H5I_INVALID_HID)), closer_(other.closer_) {}
 

@@ -7,13 +7,14 @@
 // parses exactly the bytes it has checksummed. (Writing through an image is not an option:
 // HDF5 1.10's H5Fget_file_image clears the superblock's status flags without updating its
 // checksum, and the image no longer opens.)
-// The serial library is not thread-safe: use these classes from one thread at a time.
+// The serial library is not thread-safe: use these classes under library_mutex().
 
 #include <hdf5.h>
 
 #include <concepts>
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -29,6 +30,10 @@ class Hdf5Error : public Error {
  public:
   using Error::Error;
 };
+
+/// The lock every user of the serial HDF5 library holds around its calls: files may be written
+/// and read from any thread.
+std::mutex& library_mutex();
 
 /// Element types stored by this layer, each written in a fixed little-endian file type.
 template <class T>
