@@ -12,6 +12,7 @@ packages=(
   chromium     # headless browser: the test that opens the HTML report
   slurm-wlm munge  # the single-node SLURM cluster of the psq slurm tests (scripts/slurm-localhost.sh)
   clang libclang-rt-14-dev  # libFuzzer and its sanitizers for the fuzz targets (scripts/fuzz.sh)
+  python3-meshio python3-h5py  # an independent XDMF reader for the sidecar tests (h5py: its HDF5)
 )
 missing=()
 for p in "${packages[@]}"; do
