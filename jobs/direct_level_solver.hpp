@@ -11,9 +11,22 @@
 #include "engine/core/error.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 #include "engine/sim/quasistatic.hpp"
+#include "engine/sim/shell_system.hpp"
 #include "jobs/level_solver.hpp"
 
 namespace psq::jobs {
+
+/// The shells, then the colliders, of `system`, as they lie in its concatenated arrays.
+inline std::vector<PartRange> system_parts(const ShellSystem& system) {
+  std::vector<PartRange> parts;
+  const auto add = [&](const MeshBlock& block, PartKind kind) {
+    parts.push_back({block.name, kind, block.first_vertex, block.vertex_count, block.first_triangle,
+                     block.triangle_count});
+  };
+  for (const ShellBlock& shell : system.shells()) add(shell, PartKind::shell);
+  for (const ColliderBlock& collider : system.colliders()) add(collider, PartKind::collider);
+  return parts;
+}
 
 /// A direct solve as a hierarchy of one level: QuasistaticSimulation over the scene's frames.
 class DirectLevelSolver final : public LevelSolver {
@@ -49,6 +62,7 @@ class DirectLevelSolver final : public LevelSolver {
   const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
   const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
   const TriMesh& level_rest_mesh() const override { return simulation_.system().rest_mesh(); }
+  std::vector<PartRange> level_parts() const override { return system_parts(simulation_.system()); }
   Positions finest_positions() const override { return as_positions(simulation_.positions()); }
 
   bool settles_frame(int) const override {
@@ -102,6 +116,9 @@ class ProgressiveLevelSolver final : public LevelSolver {
   const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
   const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
   const TriMesh& level_rest_mesh() const override { return simulation_.level_rest_mesh(); }
+  std::vector<PartRange> level_parts() const override {
+    return system_parts(simulation_.level_system());
+  }
   Positions finest_positions() const override {
     return as_positions(simulation_.finest_positions());
   }

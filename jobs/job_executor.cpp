@@ -7,6 +7,7 @@
 
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "engine/io/part_meshes.hpp"
 #include "engine/io/xdmf.hpp"
 #include "engine/scene/scene_reader.hpp"
 #include "jobs/heartbeat.hpp"
@@ -369,8 +370,9 @@ class JobRun {
     record(db::LevelStatus::done, file, checksum);
     test_point("level_recorded");
     run_.remove_snapshots(level);
-    add_sidecar_entry(level);
     try {
+      write_level_parts();
+      add_sidecar_entry(level);
       write_xdmf(run_.sidecar(), sidecar_entries_);
     } catch (const InputError& error) {
       throw environment_failure(error.what());
@@ -444,14 +446,26 @@ class JobRun {
                          [](const IterationRecord& it) { return it.step_length > 0.0; });
   }
 
+  /// The finished level's state, cut into its shells and colliders, for the sidecars.
+  void write_level_parts() {
+    const int frame = solver_->frame();
+    write_part_meshes(
+        run_.part_meshes(solver_->level()),
+        {.level = solver_->level(),
+         .frame = frame,
+         .time = frame * scene_.time.step,
+         .parts = split_into_parts(as_positions(solver_->positions()), solver_->level_rest_mesh(),
+                                   solver_->level_parts())});
+  }
+
   void add_sidecar_entry(int level) {
-    const fs::path file = run_.level_checkpoint(level);
+    const fs::path file = run_.part_meshes(level);
     if (std::any_of(sidecar_entries_.begin(), sidecar_entries_.end(),
                     [&](const XdmfEntry& e) { return e.level == level; }))
       return;
     try {
-      sidecar_entries_.push_back(xdmf_entry(file.filename().string(), read_checkpoint(file)));
-    } catch (const CheckpointError& error) {
+      sidecar_entries_.push_back(xdmf_entry(file.filename().string(), read_part_meshes(file)));
+    } catch (const InputError& error) {
       log(fmt::format("the sidecar leaves out level {}: {}", level, error.what()));
     }
   }

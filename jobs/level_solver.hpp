@@ -7,7 +7,9 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
+#include "engine/io/part_meshes.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 #include "engine/solver/solver_stats.hpp"
 
@@ -69,6 +71,9 @@ class LevelSolver {
   [[nodiscard]] virtual const Eigen::VectorXd& previous() const = 0;
   /// The rest mesh of the current level.
   [[nodiscard]] virtual const TriMesh& level_rest_mesh() const = 0;
+  /// The shells and colliders of the current level: where each lies in level_rest_mesh() and
+  /// positions().
+  [[nodiscard]] virtual std::vector<PartRange> level_parts() const = 0;
   /// The current level's state prolonged to the finest mesh (positions() at the finest level).
   [[nodiscard]] virtual Positions finest_positions() const = 0;
   /// Whether frame `frame` of the current level ends with settling steps to a static equilibrium

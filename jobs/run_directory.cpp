@@ -22,6 +22,10 @@ fs::path RunDirectory::previous_snapshot(int level) const {
   return dir_ / fmt::format("level_{}.snapshot.prev.h5", level);
 }
 
+fs::path RunDirectory::part_meshes(int level) const {
+  return dir_ / fmt::format("level_{}.parts.h5", level);
+}
+
 fs::path RunDirectory::sidecar() const { return dir_ / "job.xdmf"; }
 
 void RunDirectory::create() const {

@@ -1,7 +1,7 @@
 #pragma once
-// The files of one job run, `<runs>/<job id>/`: a checkpoint per finished level, the in-level
-// snapshots of the level in progress, and the XDMF sidecar. Which checkpoint a resumed job
-// continues from is decided here.
+// The files of one job run, `<runs>/<job id>/`: a checkpoint and a part-meshes file per finished
+// level, the in-level snapshots of the level in progress, and the XDMF sidecars. Which checkpoint a
+// resumed job continues from is decided here.
 
 #include <cstdint>
 #include <filesystem>
@@ -25,7 +25,11 @@ class RunDirectory {
   std::filesystem::path snapshot(int level) const;
   /// `level_<l>.snapshot.prev.h5`: the snapshot before it, kept in case the latest is damaged.
   std::filesystem::path previous_snapshot(int level) const;
-  /// `job.xdmf`: the ParaView sidecar listing the finished levels.
+  /// `level_<l>.parts.h5`: level l's final state cut into its shells and colliders, shown by
+  /// the sidecars.
+  std::filesystem::path part_meshes(int level) const;
+  /// `job.xdmf`: the ParaView sidecar listing the finished levels (the per-part sidecars
+  /// `job.<part>.xdmf` lie beside it).
   std::filesystem::path sidecar() const;
 
   /// Creates the directory (and its parents). Throws InputError naming it if that fails.

@@ -14,6 +14,7 @@
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "engine/io/part_meshes.hpp"
 #include "jobs/run_directory.hpp"
 #include "jobs/sweep_file.hpp"
 #include "support/test_paths.hpp"
@@ -79,6 +80,9 @@ class ScriptedSolver final : public jobs::LevelSolver {
   const Eigen::VectorXd& positions() const override { return x_; }
   const Eigen::VectorXd& previous() const override { return previous_; }
   const TriMesh& level_rest_mesh() const override { return rest_; }
+  std::vector<PartRange> level_parts() const override {
+    return {{"triangle", PartKind::shell, 0, 3, 0, 1}};
+  }
   Positions finest_positions() const override { return as_positions(x_); }
   /// The last frame of each level settles, as a progressive solve's refine frame does.
   bool settles_frame(int frame) const override { return frame == frames_; }
@@ -226,8 +230,13 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
   EXPECT_EQ(c.solver.scalars.at(kElasticEnergyScalar), flat(c.positions).squaredNorm());
   std::ifstream sidecar(run_dir().sidecar());
   const std::string xml{std::istreambuf_iterator<char>(sidecar), {}};
-  EXPECT_NE(xml.find("level_0.h5:/mesh/positions"), std::string::npos);
-  EXPECT_NE(xml.find("level_1.h5:/mesh/positions"), std::string::npos);
+  EXPECT_NE(xml.find("level_0.parts.h5:/parts/0/positions"), std::string::npos);
+  EXPECT_NE(xml.find("level_1.parts.h5:/parts/0/positions"), std::string::npos);
+  EXPECT_NE(xml.find(R"(<Grid Name="triangle" GridType="Uniform">)"), std::string::npos);
+  // The level's part is where the level ended.
+  const PartMeshes parts = read_part_meshes(run_dir().part_meshes(1));
+  ASSERT_EQ(parts.parts.size(), 1u);
+  EXPECT_EQ(parts.parts[0].positions, c.positions);
 }
 
 TEST_F(Executor, StopWritesASnapshotReleasesAndResumesToTheSameResult) {

@@ -85,7 +85,8 @@ void expect_complete_and_equal_to_reference(const Sweep& sweep) {
     std::set<std::string> files;
     for (const auto& entry : fs::directory_iterator(sweep.dir / "runs" / r.job.id))
       files.insert(entry.path().filename().string());
-    EXPECT_EQ(files, (std::set<std::string>{"job.xdmf", "level_0.h5"}));
+    EXPECT_EQ(files, (std::set<std::string>{"job.xdmf", "job.strip.xdmf", "level_0.h5",
+                                            "level_0.parts.h5"}));
     const Checkpoint c = sweep.final_checkpoint(r.job.id);
     const Checkpoint& expected = reference().at(r.job.id);
     ASSERT_EQ(c.positions.rows(), expected.positions.rows());

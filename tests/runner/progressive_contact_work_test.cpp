@@ -1,8 +1,9 @@
 // Sweep jobs of a contact scene with depth 2 (issue 13 items 7 and 8): `psq work` runs them
 // through the progressive solver's safe refinement; the refinement's statistics reach the level
-// checkpoint, the store's level record and the report; and a worker SIGKILLed inside the safe
+// checkpoint, the store's level record and the report; a worker SIGKILLed inside the safe
 // initialization resumes from the level it was refining and ends where an uninterrupted run
-// ends.
+// ends; and the job's XDMF sidecars show the sheet and the moving ball as blocks of every level
+// (issue 17 item 5).
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -11,6 +12,10 @@
 
 #include "db/job_store.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "engine/io/xdmf.hpp"
+#include "engine/scene/scene_reader.hpp"
+#include "engine/sim/shell_system.hpp"
+#include "io/meshio_reader.hpp"
 #include "jobs/psq_child.hpp"
 #include "runner/cantilever_workspace.hpp"
 #include "support/press_scene.hpp"
@@ -155,6 +160,64 @@ TEST(ProgressiveContactWork, AWorkerKilledInsideTheSafeInitializationResumesToTh
     EXPECT_EQ(finest.statistics.refinement.at("final_gap"),
               expected.statistics.refinement.at("final_gap"));
   }
+}
+
+/// The triangles of a JSON list of triples.
+Triangles triangles_of(const nlohmann::json& rows) {
+  Triangles triangles(static_cast<Eigen::Index>(rows.size()), 3);
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (int c = 0; c < 3; ++c) triangles(static_cast<Eigen::Index>(r), c) = rows[r][c];
+  return triangles;
+}
+
+TEST(ProgressiveContactWork, TheSidecarsShowTheSheetAndTheBallAtEveryLevelAsMeshioReadsThem) {
+  const PressSweep sweep("progressive_contact_xdmf");
+  ASSERT_EQ(sweep.run(""), 0);
+  const std::string job = sweep.results().front().job.id;
+  const fs::path sidecar = sweep.dir / "runs" / job / "job.xdmf";
+  const std::vector<fs::path> parts = part_sidecar_paths(sidecar, {"sheet", "ball"});
+  const nlohmann::json read = test::read_with_meshio(sidecar, parts);
+
+  EXPECT_TRUE(read["mismatches"].empty()) << read["mismatches"].dump();
+  ASSERT_EQ(read["blocks"].size(), 2u);  // one step per level
+  for (const nlohmann::json& step : read["blocks"])
+    EXPECT_EQ(step["grids"], (nlohmann::json{"sheet", "ball"}));
+  const nlohmann::json& sheet = read["parts"][0];
+  const nlohmann::json& ball = read["parts"][1];
+  ASSERT_EQ(sheet["steps"], 2);
+  ASSERT_EQ(ball["steps"], 2);
+
+  const ShellSystem finest(read_scene(sweep.dir / "scene.toml"));
+  for (int level = 0; level < 2; ++level) {
+    SCOPED_TRACE(::testing::Message() << "level " << level);
+    const Checkpoint c = sweep.level_checkpoint(job, level);
+    const nlohmann::json& s = sheet["frames"][level];
+    const nlohmann::json& b = ball["frames"][level];
+    const auto n = static_cast<Eigen::Index>(s["points"].size());
+    const auto m = static_cast<Eigen::Index>(s["triangles"].size());
+    // The blocks are the checkpoint's one mesh, cut where the sheet ends.
+    ASSERT_EQ(n + static_cast<Eigen::Index>(b["points"].size()), c.positions.rows());
+    ASSERT_EQ(m + static_cast<Eigen::Index>(b["triangles"].size()), c.triangles.rows());
+    test::expect_rows_near(s["points"], c.positions.topRows(n), 0.0);
+    test::expect_rows_near(b["points"], c.positions.bottomRows(c.positions.rows() - n), 0.0);
+    test::expect_rows_near(s["point_data"]["rest_position"], c.rest_positions.topRows(n), 0.0);
+    EXPECT_EQ(triangles_of(s["triangles"]), c.triangles.topRows(m));
+    EXPECT_EQ(Triangles(triangles_of(b["triangles"]).array() + static_cast<int>(n)),
+              c.triangles.bottomRows(c.triangles.rows() - m));
+    const Positions sheet_moved = c.positions.topRows(n) - c.rest_positions.topRows(n);
+    test::expect_rows_near(s["point_data"]["displacement"], sheet_moved, 0.0);
+    // Both levels end at the last frame (t = 0.4 s), where the ball's one motion has taken it
+    // 6 cm down.
+    EXPECT_EQ(c.frame, 10);
+    const Positions down = Eigen::RowVector3d(0, 0, -0.06).replicate(c.positions.rows() - n, 1);
+    test::expect_rows_near(b["point_data"]["displacement"], down, 1e-12);
+  }
+  // The finest level holds the scene's own meshes; the coarse one a coarser sheet.
+  EXPECT_EQ(sheet["frames"][1]["points"].size(),
+            static_cast<std::size_t>(finest.shells()[0].vertex_count));
+  EXPECT_EQ(ball["frames"][1]["points"].size(),
+            static_cast<std::size_t>(finest.colliders()[0].vertex_count));
+  EXPECT_LT(sheet["frames"][0]["points"].size(), sheet["frames"][1]["points"].size());
 }
 
 }  // namespace
