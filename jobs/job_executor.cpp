@@ -216,7 +216,7 @@ class JobRun {
   void continue_from(const ResumeCandidate& candidate, Checkpoint checkpoint) {
     log(fmt::format("resuming level {} frame {} from {}", checkpoint.level, checkpoint.frame,
                     candidate.file.filename().string()));
-    for (int level = 0; level < checkpoint.level; ++level) add_sidecar_entry(level);
+    for (int level = 0; level < checkpoint.level; ++level) add_stored_sidecar_entry(level);
     statistics_ = std::move(checkpoint.statistics);
     if (const auto energy = checkpoint.solver.scalars.find(kElasticEnergyScalar);
         energy != checkpoint.solver.scalars.end())
@@ -371,8 +371,10 @@ class JobRun {
     test_point("level_recorded");
     run_.remove_snapshots(level);
     try {
-      write_level_parts();
-      add_sidecar_entry(level);
+      const fs::path parts_file = run_.part_meshes(level);
+      const PartMeshes parts = level_parts();
+      write_part_meshes(parts_file, parts);
+      add_sidecar_entry(xdmf_entry(parts_file.filename().string(), parts));
       write_xdmf(run_.sidecar(), sidecar_entries_);
     } catch (const InputError& error) {
       throw environment_failure(error.what());
@@ -447,24 +449,26 @@ class JobRun {
   }
 
   /// The finished level's state, cut into its shells and colliders, for the sidecars.
-  void write_level_parts() {
+  PartMeshes level_parts() const {
     const int frame = solver_->frame();
-    write_part_meshes(
-        run_.part_meshes(solver_->level()),
-        {.level = solver_->level(),
-         .frame = frame,
-         .time = frame * scene_.time.step,
-         .parts = split_into_parts(as_positions(solver_->positions()), solver_->level_rest_mesh(),
-                                   solver_->level_parts())});
+    return {.level = solver_->level(),
+            .frame = frame,
+            .time = frame * scene_.time.step,
+            .parts = split_into_parts(as_positions(solver_->positions()),
+                                      solver_->level_rest_mesh(), solver_->level_parts())};
   }
 
-  void add_sidecar_entry(int level) {
+  void add_sidecar_entry(XdmfEntry entry) {
+    if (std::none_of(sidecar_entries_.begin(), sidecar_entries_.end(),
+                     [&](const XdmfEntry& e) { return e.level == entry.level; }))
+      sidecar_entries_.push_back(std::move(entry));
+  }
+
+  /// A level finished by an earlier attempt, listed from its part-meshes file.
+  void add_stored_sidecar_entry(int level) {
     const fs::path file = run_.part_meshes(level);
-    if (std::any_of(sidecar_entries_.begin(), sidecar_entries_.end(),
-                    [&](const XdmfEntry& e) { return e.level == level; }))
-      return;
     try {
-      sidecar_entries_.push_back(xdmf_entry(file.filename().string(), read_part_meshes(file)));
+      add_sidecar_entry(xdmf_entry(file.filename().string(), read_part_meshes(file)));
     } catch (const InputError& error) {
       log(fmt::format("the sidecar leaves out level {}: {}", level, error.what()));
     }

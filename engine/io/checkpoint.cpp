@@ -154,14 +154,6 @@ std::optional<std::string> inconsistency(const Checkpoint& c) {
 
 // ---- Encoding.
 
-template <class Matrix>
-void write_rows(hdf5::Group& group, std::string_view name, const Matrix& matrix) {
-  using Scalar = typename Matrix::Scalar;
-  group.write_dataset<Scalar>(
-      name, std::span(matrix.data(), static_cast<std::size_t>(matrix.size())),
-      {static_cast<hsize_t>(matrix.rows()), static_cast<hsize_t>(matrix.cols())});
-}
-
 void write_named_values(hdf5::Group group, const std::map<std::string, double>& values) {
   for (const auto& [name, value] : values) group.write_attribute(name, value);
 }
@@ -183,7 +175,7 @@ void write_iterations(hdf5::Group group, const std::vector<IterationRecord>& rec
 void write_solver_state(hdf5::Group group, const SolverState& solver) {
   group.write_attribute("progress", progress_name(solver.progress));
   group.write_attribute("iterations_in_frame", solver.iterations_in_frame);
-  write_rows(group, "previous_positions", solver.previous_positions);
+  hdf5::write_rows(group, "previous_positions", solver.previous_positions);
   write_named_values(group.create_group("scalars"), solver.scalars);
 }
 
@@ -206,28 +198,16 @@ void encode(const Checkpoint& c, const std::filesystem::path& path) {
   root.write_attribute("time", c.time);
   root.write_attribute("content_checksum", content_checksum(c, checkpoint_schema_version));
   root.create_group("mesh");
-  write_rows(root, checkpoint_layout::positions, c.positions);
-  write_rows(root, checkpoint_layout::rest_positions, c.rest_positions);
-  write_rows(root, checkpoint_layout::triangles, c.triangles);
-  write_rows(root, checkpoint_layout::finest_positions, c.finest_positions);
+  hdf5::write_rows(root, checkpoint_layout::positions, c.positions);
+  hdf5::write_rows(root, checkpoint_layout::rest_positions, c.rest_positions);
+  hdf5::write_rows(root, checkpoint_layout::triangles, c.triangles);
+  hdf5::write_rows(root, checkpoint_layout::finest_positions, c.finest_positions);
   write_solver_state(root.create_group("solver"), c.solver);
   write_statistics(root.create_group("statistics"), c.statistics);
   file.close();
 }
 
 // ---- Decoding.
-
-template <class Matrix>
-Matrix read_rows(const hdf5::Group& group, std::string_view name) {
-  using Scalar = typename Matrix::Scalar;
-  const hdf5::Array<Scalar> array = group.read_dataset<Scalar>(name);
-  if (array.shape.size() != 2 || array.shape[1] != 3)
-    fail(group.file_name(), fmt::format("{} in {} has shape ({}), expected (n, 3)", name,
-                                        group.path(), fmt::join(array.shape, ", ")));
-  Matrix matrix(static_cast<Eigen::Index>(array.shape[0]), 3);
-  std::copy(array.values.begin(), array.values.end(), matrix.data());
-  return matrix;
-}
 
 std::map<std::string, double> read_named_values(const hdf5::Group& group) {
   std::map<std::string, double> values;
@@ -285,10 +265,10 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   c.level = root.read_attribute<std::int32_t>("level");
   c.frame = root.read_attribute<std::int32_t>("frame");
   c.time = root.read_attribute<double>("time");
-  c.positions = read_rows<Positions>(root, checkpoint_layout::positions);
-  c.rest_positions = read_rows<Positions>(root, checkpoint_layout::rest_positions);
-  c.triangles = read_rows<Triangles>(root, checkpoint_layout::triangles);
-  c.finest_positions = read_rows<Positions>(root, checkpoint_layout::finest_positions);
+  c.positions = hdf5::read_rows<Positions>(root, checkpoint_layout::positions);
+  c.rest_positions = hdf5::read_rows<Positions>(root, checkpoint_layout::rest_positions);
+  c.triangles = hdf5::read_rows<Triangles>(root, checkpoint_layout::triangles);
+  c.finest_positions = hdf5::read_rows<Positions>(root, checkpoint_layout::finest_positions);
 
   const hdf5::Group solver = root.open_group("solver");
   const std::string progress = solver.read_string_attribute("progress");
@@ -296,7 +276,7 @@ Checkpoint decode(const std::string& file_name, std::span<const char> bytes) {
   if (!parsed) fail(file_name, fmt::format("unknown solver progress '{}'", progress));
   c.solver.progress = *parsed;
   c.solver.iterations_in_frame = solver.read_attribute<std::int32_t>("iterations_in_frame");
-  c.solver.previous_positions = read_rows<Positions>(solver, "previous_positions");
+  c.solver.previous_positions = hdf5::read_rows<Positions>(solver, "previous_positions");
   c.solver.scalars = read_named_values(solver.open_group("scalars"));
 
   const hdf5::Group statistics = root.open_group("statistics");

@@ -9,8 +9,11 @@
 // checksum, and the image no longer opens.)
 // The serial library is not thread-safe: use these classes under library_mutex().
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <hdf5.h>
 
+#include <algorithm>
 #include <concepts>
 #include <cstdint>
 #include <filesystem>
@@ -146,5 +149,29 @@ class File {
   Id id_;  // declared before root_ so that the root group closes first
   Group root_;
 };
+
+/// Writes an Eigen matrix (row-major, as Positions and Triangles are) as a (rows, cols) dataset.
+template <class Matrix>
+void write_rows(Group& group, std::string_view name, const Matrix& matrix) {
+  using Scalar = typename Matrix::Scalar;
+  group.write_dataset<Scalar>(
+      name, std::span(matrix.data(), static_cast<std::size_t>(matrix.size())),
+      {static_cast<hsize_t>(matrix.rows()), static_cast<hsize_t>(matrix.cols())});
+}
+
+/// Reads an (n, 3) dataset into a row-major Eigen matrix. Throws Hdf5Error naming the dataset
+/// when it has another shape.
+template <class Matrix>
+Matrix read_rows(const Group& group, std::string_view name) {
+  using Scalar = typename Matrix::Scalar;
+  const Array<Scalar> array = group.read_dataset<Scalar>(name);
+  if (array.shape.size() != 2 || array.shape[1] != 3)
+    throw Hdf5Error(located_message(group.file_name(), 0,
+                                    fmt::format("{} in {} has shape ({}), expected (n, 3)", name,
+                                                group.path(), fmt::join(array.shape, ", "))));
+  Matrix matrix(static_cast<typename Matrix::Index>(array.shape[0]), 3);
+  std::copy(array.values.begin(), array.values.end(), matrix.data());
+  return matrix;
+}
 
 }  // namespace psq::hdf5

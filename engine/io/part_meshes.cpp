@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 
 #include <array>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -13,6 +11,7 @@
 
 #include "engine/core/atomic_file.hpp"
 #include "engine/core/error.hpp"
+#include "engine/core/input_file.hpp"
 #include "engine/io/hdf5_handle.hpp"
 
 namespace psq {
@@ -81,25 +80,6 @@ std::optional<std::string> inconsistency(const PartMesh& part) {
   return std::nullopt;
 }
 
-template <class Matrix>
-void write_rows(hdf5::Group& group, std::string_view name, const Matrix& matrix) {
-  using Scalar = typename Matrix::Scalar;
-  group.write_dataset<Scalar>(
-      name, std::span(matrix.data(), static_cast<std::size_t>(matrix.size())),
-      {static_cast<hsize_t>(matrix.rows()), static_cast<hsize_t>(matrix.cols())});
-}
-
-template <class Matrix>
-Matrix read_rows(const hdf5::Group& group, std::string_view name) {
-  using Scalar = typename Matrix::Scalar;
-  const hdf5::Array<Scalar> array = group.read_dataset<Scalar>(name);
-  if (array.shape.size() != 2 || array.shape[1] != 3)
-    fail(group.file_name(), fmt::format("{}/{} is not an (n, 3) array", group.path(), name));
-  Matrix matrix(static_cast<Eigen::Index>(array.shape[0]), 3);
-  std::copy(array.values.begin(), array.values.end(), matrix.data());
-  return matrix;
-}
-
 void encode(const PartMeshes& meshes, const std::filesystem::path& path) {
   hdf5::File file = hdf5::File::create(path);
   hdf5::Group& root = file.root();
@@ -115,11 +95,11 @@ void encode(const PartMeshes& meshes, const std::filesystem::path& path) {
     hdf5::Group group = root.create_group(part_mesh_layout::group(k));
     group.write_attribute("name", part.name);
     group.write_attribute("kind", kind_name(part.kind));
-    write_rows(group, part_mesh_layout::positions, part.positions);
-    write_rows(group, part_mesh_layout::rest_positions, part.rest_positions);
+    hdf5::write_rows(group, part_mesh_layout::positions, part.positions);
+    hdf5::write_rows(group, part_mesh_layout::rest_positions, part.rest_positions);
     const Positions displacement = part.positions - part.rest_positions;
-    write_rows(group, part_mesh_layout::displacement, displacement);
-    write_rows(group, part_mesh_layout::triangles, part.triangles);
+    hdf5::write_rows(group, part_mesh_layout::displacement, displacement);
+    hdf5::write_rows(group, part_mesh_layout::triangles, part.triangles);
   }
   file.close();
 }
@@ -130,11 +110,12 @@ PartMesh decode_part(const hdf5::Group& root, std::size_t k) {
   const std::optional<PartKind> parsed = parse_kind(kind);
   if (!parsed)
     fail(root.file_name(), fmt::format("{}: unknown part kind '{}'", group.path(), kind));
-  PartMesh part{.name = group.read_string_attribute("name"),
-                .kind = *parsed,
-                .positions = read_rows<Positions>(group, part_mesh_layout::positions),
-                .rest_positions = read_rows<Positions>(group, part_mesh_layout::rest_positions),
-                .triangles = read_rows<Triangles>(group, part_mesh_layout::triangles)};
+  PartMesh part{
+      .name = group.read_string_attribute("name"),
+      .kind = *parsed,
+      .positions = hdf5::read_rows<Positions>(group, part_mesh_layout::positions),
+      .rest_positions = hdf5::read_rows<Positions>(group, part_mesh_layout::rest_positions),
+      .triangles = hdf5::read_rows<Triangles>(group, part_mesh_layout::triangles)};
   if (const auto problem = inconsistency(part)) fail(root.file_name(), *problem);
   return part;
 }
@@ -157,14 +138,6 @@ PartMeshes decode(const std::string& file_name, std::span<const char> bytes) {
   if (count < 0) fail(file_name, fmt::format("negative part_count {}", count));
   for (int k = 0; k < count; ++k) meshes.parts.push_back(decode_part(root, k));
   return meshes;
-}
-
-std::vector<char> read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path.string(), "cannot open the part-meshes file");
-  std::vector<char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) fail(path.string(), "read error");
-  return bytes;
 }
 
 }  // namespace
@@ -194,10 +167,10 @@ void write_part_meshes(const std::filesystem::path& path, const PartMeshes& mesh
 }
 
 PartMeshes read_part_meshes(const std::filesystem::path& path) {
-  const std::vector<char> bytes = read_bytes(path);
+  const std::string bytes = read_input_file(path, "part-meshes file");
   try {
     const std::lock_guard lock(hdf5::library_mutex());
-    return decode(path.string(), bytes);
+    return decode(path.string(), std::span(bytes.data(), bytes.size()));
   } catch (const hdf5::Hdf5Error& e) {
     fail(path.string(), fmt::format("damaged or not a part-meshes file: {}", e.what()));
   }
