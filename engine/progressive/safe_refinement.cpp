@@ -273,6 +273,57 @@ double mixed_gap(const MixedMesh& mesh, const BodyPairRule& may_touch, const Pos
   return broad.clearance(mesh.positions(y), 0.0, cap);
 }
 
+/// The patch relaxation of one batch (§4.4.4): the batch's vertices of the mixed mesh's pairs
+/// closer than g are relaxed toward their targets (relax_free_vertices) on the mixed surface,
+/// the rest held. Without it a batch whose clusters its advance stopped near their parents
+/// leaves gaps far below g, and each later batch's perturbation, bounded by the gap, shrinks with
+/// them. The CCD keeps pairs apart but sees no neighbouring triangles folding across their
+/// shared edge, so a relaxation that ends with a fold or a degenerate triangle is discarded.
+RelaxationStats relax_batch(const MixedMesh& mesh, const ContactSurface& surface,
+                            const ContactParameters& parameters, double bbox_diagonal,
+                            const std::vector<bool>& movable, double gap, const Positions& goal,
+                            Positions& y) {
+  ContactSurface mixed_surface;
+  mixed_surface.triangles = mesh.triangles;
+  mixed_surface.edges = mesh.edges;
+  mixed_surface.vertex_body = mesh.body;
+  mixed_surface.may_touch = surface.may_touch;
+  mixed_surface.rest = mesh.positions(surface.rest);
+  ContactTerm contact(std::move(mixed_surface), parameters, std::nullopt, bbox_diagonal, 1.0);
+  Eigen::VectorXd x = flat(mesh.positions(y));
+  const int m = static_cast<int>(mesh.fine_vertex.size());
+  std::vector<bool> freed(m, false);
+  for (const ContactPair& pair : contact.potential().active_pairs(x))
+    if (std::sqrt(pair_distance(pair, x)) < gap)
+      for (int k : pair.vertices)
+        if (k >= 0 && movable[mesh.fine_vertex[k]]) freed[k] = true;
+  std::vector<int> held;
+  for (int k = 0; k < m; ++k)
+    if (!freed[k]) held.push_back(k);
+  const DofMap dofs(m, held);
+  RelaxationStats stats;
+  try {
+    stats = relax_free_vertices(contact, flat(mesh.positions(goal)), dofs, x);
+  } catch (const NumericalError&) {
+    // A pair left nearly coincident by a vertex-by-vertex split gives the CCD no step: the
+    // batch stays as its advance left it, intersection-free, and the later advances and the
+    // final relaxation take it from there.
+    return stats;
+  }
+  if (stats.vertices == 0) return stats;
+  const Positions p = as_positions(x);
+  if (!intersecting_vertices(mesh, p, surface.may_touch, false).empty()) return stats;
+  for (int k = 0; k < m; ++k) y.row(mesh.fine_vertex[k]) = p.row(k);
+  return stats;
+}
+
+/// Adds a relaxation's work to the refinement's statistics.
+void add(RefinementStats& stats, const RelaxationStats& relaxation) {
+  stats.relaxed_vertices += relaxation.vertices;
+  stats.relax_iterations += relaxation.iterations;
+  stats.relax_seconds += relaxation.seconds;
+}
+
 /// The random numbers of a retry, seeded by the level, the vertex and the try, so that a
 /// resumed run repeats them.
 std::mt19937_64 seeded_random(int level, int vertex, int tries) {
@@ -301,9 +352,11 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   ccd.min_distance = parameters.band.thickness;
   ccd.max_iterations = kAdvanceCcdIterations;
   const double cap = parameters.band.thickness + parameters.band.activation_distance;
-  const double perturbation_floor =
-      kPerturbationFloor * bounding_box_diagonal(fine.rest_mesh().vertices);
+  const double bbox_diagonal = bounding_box_diagonal(fine.rest_mesh().vertices);
+  const double perturbation_floor = kPerturbationFloor * bbox_diagonal;
   const int n = static_cast<int>(parent.size());
+  std::vector<bool> pinned(n, false);
+  for (const PinnedVertex& pin : fine.pinned()) pinned[pin.vertex] = true;
   const int coarse_count = static_cast<int>(color.size());
   const Eigen::Map<const Positions> coarse = as_positions(coarse_x);
   const Eigen::Map<const Positions> goal = as_positions(target);
@@ -568,6 +621,11 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
       for (int v : children[k]) delta.row(v) = goal.row(v) - y.row(v);
     stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(delta));
     stats.ccd_seconds += since(phase);
+
+    std::vector<bool> movable(n, false);
+    for (int k : clusters)
+      for (int v : children[k]) movable[v] = !pinned[v];
+    add(stats, relax_batch(mixed, surface, parameters, bbox_diagonal, movable, safe_gap, goal, y));
   }
 
   // Every vertex the rest of the way, as far as it safely goes.
@@ -583,9 +641,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   Eigen::VectorXd relaxed = flat(y);
   const RelaxationStats relaxation = relax_toward_targets(fine, target, safe_gap, relaxed);
   y = as_positions(relaxed);
-  stats.relaxed_vertices = relaxation.vertices;
-  stats.relax_iterations = relaxation.iterations;
-  stats.relax_seconds = relaxation.seconds;
+  add(stats, relaxation);
 
   tell("exact check");
   phase = Clock::now();

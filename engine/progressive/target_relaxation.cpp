@@ -43,7 +43,6 @@ double TargetPull::max_feasible_step(const Eigen::VectorXd& x, const Eigen::Vect
 
 RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::VectorXd& target,
                                      double safe_gap, Eigen::VectorXd& x) {
-  const auto started = std::chrono::steady_clock::now();
   ContactTerm contact(fine);
   const double reach = contact.potential().parameters().band.activation_distance;
   const Eigen::Index n = x.size() / 3;
@@ -54,8 +53,12 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
   for (const ContactPair& pair : contact.potential().active_pairs(x))
     if (std::sqrt(pair_distance(pair, x)) < safe_gap)
       for (int v : pair.vertices) freed[v] = true;
-  const DofMap dofs = movable_vertex_dofs(fine, freed);
+  return relax_free_vertices(contact, target, movable_vertex_dofs(fine, freed), x);
+}
 
+RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
+                                    const DofMap& dofs, Eigen::VectorXd& x) {
+  const auto started = std::chrono::steady_clock::now();
   RelaxationStats stats;
   stats.vertices = static_cast<int>(dofs.free_size() / 3);
   if (stats.vertices == 0) return stats;
@@ -65,7 +68,7 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
   NewtonSolver newton;
   NewtonSettings settings;
   settings.max_iterations = kIterationsPerUpdate;
-  settings.tolerance = kRelaxTolerance * reach;
+  settings.tolerance = kRelaxTolerance * contact.potential().parameters().band.activation_distance;
   for (int done = 0; done < kMaxIterations; done += kIterationsPerUpdate) {
     const NewtonResult result = newton.minimize(pull, x, dofs, settings);
     stats.iterations += result.iterations;

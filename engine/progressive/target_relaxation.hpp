@@ -22,6 +22,7 @@
 
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/shell_system.hpp"
+#include "engine/solver/dof_map.hpp"
 #include "engine/solver/objective.hpp"
 
 namespace psq {
@@ -55,5 +56,11 @@ struct RelaxationStats {
 /// above, where `safe_gap` is g. x is unchanged when no vertex needs it.
 RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::VectorXd& target,
                                      double safe_gap, Eigen::VectorXd& x);
+
+/// Minimizes R over the DOFs `dofs` frees, from x (intersection-free), with κ balanced against
+/// the pull at x and IPC's updates: the relaxation of relax_toward_targets on any contact
+/// surface, such as a partly expanded level's between two batches (paper §4.4.4).
+RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
+                                    const DofMap& dofs, Eigen::VectorXd& x);
 
 }  // namespace psq

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 namespace psq {
 namespace {
@@ -22,6 +23,13 @@ constexpr double kStiffnessRangeWidening = 1e4;
 void append_edges(const MeshTopology& topology, int first_vertex,
                   std::vector<std::array<int, 2>>& edges) {
   for (const auto& e : topology.edges) edges.push_back({e[0] + first_vertex, e[1] + first_vertex});
+}
+
+/// The mean mass of a DOF of the system's shells (colliders have none).
+double shell_average_mass(const ShellSystem& system) {
+  int shell_vertices = 0;
+  for (const ShellBlock& shell : system.shells()) shell_vertices += shell.vertex_count;
+  return system.dof_masses().head(3 * shell_vertices).sum() / (3.0 * shell_vertices);
 }
 
 }  // namespace
@@ -67,16 +75,19 @@ ContactParameters contact_parameters(const ShellSystem& system) {
 }
 
 ContactTerm::ContactTerm(const ShellSystem& system)
-    : potential_(contact_surface(system, system.scene().contact.self_contact),
-                 contact_parameters(system)),
-      fixed_stiffness_(system.scene().contact.stiffness.has_value()),
-      bbox_diagonal_(bounding_box_diagonal(system.rest_mesh().vertices)),
-      average_mass_(0.0),
+    : ContactTerm(contact_surface(system, system.scene().contact.self_contact),
+                  contact_parameters(system), system.scene().contact.stiffness,
+                  bounding_box_diagonal(system.rest_mesh().vertices), shell_average_mass(system)) {}
+
+ContactTerm::ContactTerm(ContactSurface surface, const ContactParameters& parameters,
+                         std::optional<double> fixed_stiffness, double bbox_diagonal,
+                         double average_mass)
+    : potential_(std::move(surface), parameters),
+      fixed_stiffness_(fixed_stiffness.has_value()),
+      bbox_diagonal_(bbox_diagonal),
+      average_mass_(average_mass),
       previous_min_distance_(std::numeric_limits<double>::infinity()) {
-  int shell_vertices = 0;
-  for (const ShellBlock& shell : system.shells()) shell_vertices += shell.vertex_count;
-  average_mass_ = system.dof_masses().head(3 * shell_vertices).sum() / (3.0 * shell_vertices);
-  stiffness_.value = system.scene().contact.stiffness.value_or(0.0);
+  stiffness_.value = fixed_stiffness.value_or(0.0);
   stiffness_.max = stiffness_.value;
   potential_.set_stiffness(stiffness_.value);
 }

@@ -32,6 +32,11 @@ class ContactTerm : public PotentialTerm {
   /// The contact term of `system` with its scene's settings. κ starts at the scene's
   /// `stiffness` when given (then it stays fixed), else at 0 until initialize_stiffness.
   explicit ContactTerm(const ShellSystem& system);
+  /// The contact term of any surface (a partly refined level's, for one batch of its safe
+  /// initialization): κ fixed at `fixed_stiffness` when given; `bbox_diagonal` is l of IPC's
+  /// rules, `average_mass` the mean vertex mass.
+  ContactTerm(ContactSurface surface, const ContactParameters& parameters,
+              std::optional<double> fixed_stiffness, double bbox_diagonal, double average_mass);
 
   [[nodiscard]] ContactPotential& potential() { return potential_; }
   [[nodiscard]] double stiffness() const { return potential_.stiffness(); }

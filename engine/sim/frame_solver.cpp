@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "engine/core/error.hpp"
@@ -210,17 +211,25 @@ void FrameSolver::solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous
   friction_->reset_seconds();
   friction_->lag(contact_->potential(), previous, frame_start);
   Eigen::VectorXd last_solution;
+  double last_change = std::numeric_limits<double>::infinity();
   for (int iteration = 1;; ++iteration) {
     const bool had_contacts = friction_->contact_count() > 0;
     append_solve(record.newton, solve_in_chunks(x, dofs_, settings, progress));
     ++record.friction_iterations;
-    const bool settled =
-        last_solution.size() == x.size() &&
-        (x - last_solution).lpNorm<Eigen::Infinity>() / settings.step_scale < settings.tolerance;
+    const double change = last_solution.size() == x.size()
+                              ? (x - last_solution).lpNorm<Eigen::Infinity>() / settings.step_scale
+                              : std::numeric_limits<double>::infinity();
+    const bool settled = change < settings.tolerance;
     if (!record.newton.converged || settled || iteration == kMaxFrictionIterations) break;
-    friction_->lag(contact_->potential(), x, frame_start);
+    Eigen::VectorXd lag_state = x;
+    if (std::isfinite(change) && change >= 0.5 * last_change) {
+      Eigen::VectorXd mid = 0.5 * (x + last_solution);
+      if (std::isfinite(contact_->potential().value(mid))) lag_state = std::move(mid);
+    }
+    friction_->lag(contact_->potential(), lag_state, frame_start);
     if (!had_contacts && friction_->contact_count() == 0) break;
     last_solution = x;
+    last_change = change;
   }
   potential_.remove_term(*friction_);
   record.friction_seconds += friction_->seconds();
