@@ -303,7 +303,7 @@ RelaxationStats relax_batch(const MixedMesh& mesh, const ContactSurface& surface
   const DofMap dofs(m, held);
   RelaxationStats stats;
   try {
-    stats = relax_free_vertices(contact, flat(mesh.positions(goal)), dofs, x);
+    stats = relax_free_vertices(contact, flat(mesh.positions(goal)), dofs, gap, x);
   } catch (const NumericalError&) {
     // A pair left nearly coincident by a vertex-by-vertex split gives the CCD no step: the
     // batch stays as its advance left it, intersection-free, and the later advances and the
@@ -312,7 +312,10 @@ RelaxationStats relax_batch(const MixedMesh& mesh, const ContactSurface& surface
   }
   if (stats.vertices == 0) return stats;
   const Positions p = as_positions(x);
-  if (!intersecting_vertices(mesh, p, surface.may_touch, false).empty()) return stats;
+  if (!intersecting_vertices(mesh, p, surface.may_touch, false).empty()) {
+    stats.vertices = 0;  // its work is counted, but no vertex was relaxed
+    return stats;
+  }
   for (int k = 0; k < m; ++k) y.row(mesh.fine_vertex[k]) = p.row(k);
   return stats;
 }

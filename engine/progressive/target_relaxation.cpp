@@ -1,7 +1,9 @@
 #include "engine/progressive/target_relaxation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "engine/progressive/local_solve.hpp"
 #include "engine/sim/strain_limit_term.hpp"
@@ -10,12 +12,34 @@
 namespace psq {
 namespace {
 
-/// Newton iterations between two κ updates, and the budget of the relaxation.
+/// Newton iterations between two κ updates, and the budget of one stiffness round.
 constexpr int kIterationsPerUpdate = 10;
 constexpr int kMaxIterations = 50;
-/// Newton's step tolerance as a fraction of d̂: the level's solve takes over from here, so the
-/// relaxation only has to bring each vertex to its place at the barrier's scale.
+/// Newton's step tolerance as a fraction of the smaller of g and d̂: the level's solve takes over
+/// from here, so the relaxation only has to bring each vertex to its place at the scale of the
+/// gap it restores.
 constexpr double kRelaxTolerance = 1e-2;
+/// The gap is restored when every pair with a freed vertex is at least this fraction of g apart:
+/// the pull toward targets that lie closer than g keeps the balance just below g.
+constexpr double kRestoredGapFraction = 0.5;
+/// Stiffness rounds after the first, each with κ this many times larger (§4.4.3: "an increasing
+/// schedule of barrier stiffness"): the balanced distance of a pair grows about in proportion to
+/// κ, so three rounds take a pair from 1e-3 g to g.
+constexpr int kStiffnessRounds = 3;
+constexpr double kStiffnessGrowth = 10.0;
+
+/// The smallest distance of x's active pairs that have a vertex `dofs` frees (infinity when
+/// there is none).
+double closest_free_pair(ContactTerm& contact, const DofMap& dofs, const Eigen::VectorXd& x) {
+  double closest = std::numeric_limits<double>::infinity();
+  for (const ContactPair& pair : contact.potential().active_pairs(x))
+    for (int v : pair.vertices)
+      if (v >= 0 && dofs.reduced(3 * static_cast<Eigen::Index>(v)) >= 0) {
+        closest = std::min(closest, std::sqrt(pair_distance(pair, x)));
+        break;
+      }
+  return closest;
+}
 
 }  // namespace
 
@@ -53,11 +77,11 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
   for (const ContactPair& pair : contact.potential().active_pairs(x))
     if (std::sqrt(pair_distance(pair, x)) < safe_gap)
       for (int v : pair.vertices) freed[v] = true;
-  return relax_free_vertices(contact, target, movable_vertex_dofs(fine, freed), x);
+  return relax_free_vertices(contact, target, movable_vertex_dofs(fine, freed), safe_gap, x);
 }
 
 RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
-                                    const DofMap& dofs, Eigen::VectorXd& x) {
+                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x) {
   const auto started = std::chrono::steady_clock::now();
   RelaxationStats stats;
   stats.vertices = static_cast<int>(dofs.free_size() / 3);
@@ -68,12 +92,20 @@ RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd&
   NewtonSolver newton;
   NewtonSettings settings;
   settings.max_iterations = kIterationsPerUpdate;
-  settings.tolerance = kRelaxTolerance * contact.potential().parameters().band.activation_distance;
-  for (int done = 0; done < kMaxIterations; done += kIterationsPerUpdate) {
-    const NewtonResult result = newton.minimize(pull, x, dofs, settings);
-    stats.iterations += result.iterations;
-    if (result.converged || result.stagnated) break;
-    contact.update_stiffness(x, false);
+  settings.tolerance =
+      kRelaxTolerance *
+      std::min(safe_gap, contact.potential().parameters().band.activation_distance);
+  for (int round = 0;; ++round) {
+    for (int done = 0; done < kMaxIterations; done += kIterationsPerUpdate) {
+      const NewtonResult result = newton.minimize(pull, x, dofs, settings);
+      stats.iterations += result.iterations;
+      if (result.converged || result.stagnated) break;
+      contact.update_stiffness(x, false);
+    }
+    if (round == kStiffnessRounds ||
+        closest_free_pair(contact, dofs, x) >= kRestoredGapFraction * safe_gap)
+      break;
+    contact.scale_stiffness(kStiffnessGrowth);
   }
   stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -1,12 +1,15 @@
 #pragma once
 // Patch relaxation of a safe initialization (paper §4.4.3). The CCD advances of
 // safe_refinement.hpp stop each vertex of a limiting pair where the pair limited it, so pairs can
-// end far closer than the safe gap g, which the level's barrier then meets at its singular end. The relaxation frees the vertices of pairs closer than g and
-// minimizes
+// end far closer than the safe gap g, which the level's barrier then meets at its singular end. The
+// relaxation frees the vertices of pairs closer than g and minimizes
 //   R(y) = ½ Σ_v ‖y_v − t_v‖² + κ B(y)
 // over them, t the prolonged targets, B the scene's contact barrier with κ from IPC's balance
 // with the pull, by Newton with CCD-cut steps: the pairs are pushed back toward d̂ while each
-// vertex stays as near its target as the barrier allows.
+// vertex stays as near its target as the barrier allows. Where the balance leaves a pair closer
+// than g/2, κ is raised tenfold and the solve repeated ("an increasing schedule of barrier
+// stiffness, until the balance ... restores the gap", §4.4.3): the balanced distance of a pair
+// pulled together grows about in proportion to κ.
 //
 // With a strain limit it also frees the stragglers, the vertices farther than d̂ from their
 // targets: a vertex whose target lies beyond an obstacle (a child of cloth resting on a sphere,
@@ -58,9 +61,10 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
                                      double safe_gap, Eigen::VectorXd& x);
 
 /// Minimizes R over the DOFs `dofs` frees, from x (intersection-free), with κ balanced against
-/// the pull at x and IPC's updates: the relaxation of relax_toward_targets on any contact
-/// surface, such as a partly expanded level's between two batches (paper §4.4.4).
+/// the pull at x and IPC's updates, then raised tenfold per round while a pair with a freed
+/// vertex stays closer than g/2 (at most three times): the relaxation of relax_toward_targets on
+/// any contact surface, such as a partly expanded level's between two batches (paper §4.4.4).
 RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
-                                    const DofMap& dofs, Eigen::VectorXd& x);
+                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x);
 
 }  // namespace psq

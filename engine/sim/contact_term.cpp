@@ -124,6 +124,13 @@ bool ContactTerm::update_stiffness(const Eigen::VectorXd& x, bool steps_cut_by_c
   return true;
 }
 
+void ContactTerm::scale_stiffness(double factor) {
+  if (fixed_stiffness_) return;
+  stiffness_.value *= factor;
+  stiffness_.max = std::max(stiffness_.max, stiffness_.value);
+  potential_.set_stiffness(stiffness_.value);
+}
+
 namespace {
 constexpr const char* kStiffnessName = "contact.stiffness";
 constexpr const char* kMaxStiffnessName = "contact.max_stiffness";

@@ -54,6 +54,9 @@ class ContactTerm : public PotentialTerm {
   /// `steps_cut_by_ccd` (the CCD cut most of the last steps short) raises it to hold the
   /// contact force at ε_g. Returns whether κ changed.
   bool update_stiffness(const Eigen::VectorXd& x, bool steps_cut_by_ccd);
+  /// κ times `factor`, past IPC's rules, unless the scene fixes κ: for a relaxation that must
+  /// push pairs apart to a given gap rather than balance the forces at x.
+  void scale_stiffness(double factor);
 
   /// Adds κ, its upper bound and the last smallest distance to `state` ("contact.*").
   void save_state(std::map<std::string, double>& state) const;
