@@ -13,6 +13,7 @@
 #include "engine/core/error.hpp"
 #include "engine/core/input_file.hpp"
 #include "engine/scene/key_suggestion.hpp"
+#include "engine/scene/scene_document.hpp"
 
 namespace psq {
 namespace {
@@ -99,8 +100,10 @@ class Section {
     const auto suggestion = suggest_key(unknown->str(), allowed);
     const std::string hint = suggestion ? fmt::format("did you mean '{}'?", *suggestion)
                                         : fmt::format("valid keys: {}", quoted_list(allowed));
-    fail(static_cast<long>(unknown->source().begin.line),
-         fmt::format("unknown key '{}' {}; {}", unknown->str(), where(), hint));
+    throw UnknownKeyError(
+        located_message(file_, static_cast<long>(unknown->source().begin.line),
+                        fmt::format("unknown key '{}' {}; {}", unknown->str(), where(), hint)),
+        std::string(unknown->str()), suggestion);
   }
 
   /// The value of an optional key, `fallback` when absent.
@@ -694,7 +697,10 @@ Collider read_collider(const Section& section, const fs::path& scene_path) {
   return collider;
 }
 
-toml::table parse_toml(std::string_view text, const std::string& source) {
+}  // namespace
+
+toml::table parse_scene_document(std::string_view text, const fs::path& path) {
+  const std::string source = path.string();
   try {
     return toml::parse(text, std::string_view(source));
   } catch (const toml::parse_error& error) {
@@ -708,14 +714,15 @@ toml::table parse_toml(std::string_view text, const std::string& source) {
   }
 }
 
-}  // namespace
-
 Scene read_scene(const fs::path& path) {
   return read_scene_text(read_input_file(path, "scene file"), path);
 }
 
 Scene read_scene_text(std::string_view text, const fs::path& path) {
-  const toml::table document = parse_toml(text, path.string());
+  return read_scene_document(parse_scene_document(text, path), path);
+}
+
+Scene read_scene_document(const toml::table& document, const fs::path& path) {
   const Section root(document, "", path.string());
   root.allow_only(
       {"name", "gravity", "time", "solver", "hierarchy", "contact", "shell", "collider"});
