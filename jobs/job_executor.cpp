@@ -9,7 +9,6 @@
 #include "engine/io/checkpoint.hpp"
 #include "engine/io/part_meshes.hpp"
 #include "engine/io/xdmf.hpp"
-#include "engine/scene/scene_reader.hpp"
 #include "jobs/heartbeat.hpp"
 #include "jobs/job_identity.hpp"
 #include "jobs/run_directory.hpp"
@@ -71,9 +70,9 @@ Scene job_scene(const db::Job& job) {
   const nlohmann::json stored = job.parameters.value("overrides", nlohmann::json::object());
   for (const auto& [path, value] : stored.items()) overrides[path] = value;
   try {
-    return apply_overrides(read_scene(job.scene), overrides);
+    return SceneDocument::read(job.scene).apply(overrides);
   } catch (const OverrideError& error) {
-    throw InputError(fmt::format("{}: parameter {}: {}", job.scene, error.path(), error.what()));
+    throw InputError(fmt::format("{}: {}", job.scene, error.what()));
   }
 }
 

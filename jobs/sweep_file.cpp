@@ -13,7 +13,6 @@
 #include "engine/core/error.hpp"
 #include "engine/core/input_file.hpp"
 #include "engine/scene/key_suggestion.hpp"
-#include "engine/scene/scene_reader.hpp"
 #include "jobs/scene_overrides.hpp"
 
 namespace psq::jobs {
@@ -57,7 +56,7 @@ class SweepReader {
     sweep.name = required_string("name");
     sweep.scene = scene_path();
     sweep.scene_hash = file_content_hash(sweep.scene);
-    const Scene base = read_scene(sweep.scene);
+    const SceneDocument base = SceneDocument::read(sweep.scene);
     const std::vector<Axis> axes = read_axes(base);
     check_job_count(axes);
     const Value depth = default_depth(axes);
@@ -167,7 +166,7 @@ class SweepReader {
 
   /// The [grid] lists (one axis each) and the [[zip]] groups, each path checked against the
   /// scene and varied once.
-  std::vector<Axis> read_axes(const Scene& base) const {
+  std::vector<Axis> read_axes(const SceneDocument& base) const {
     std::vector<Axis> axes;
     std::set<std::string> varied;
     auto add_path = [&](Axis& axis, std::string path, std::vector<Value> values) {
@@ -176,7 +175,7 @@ class SweepReader {
         fail(line, fmt::format("parameter '{}' is varied twice; list it once", path));
       if (path != kDepth) {
         try {
-          check_parameter_path(base, path);
+          base.check_path(path);
         } catch (const OverrideError& error) {
           fail(line, error.what());
         }
@@ -245,10 +244,22 @@ class SweepReader {
     }
   }
 
+  /// The canonical form of `value` for `path`, made once per value: each takes a scene read
+  /// or two, and a value recurs in many jobs.
+  nlohmann::json canonical(const SceneDocument& base, const std::string& path,
+                           const Value& value) const {
+    const auto key = std::make_pair(path, value.raw.dump());
+    const auto known = canonical_values_.find(key);
+    if (known != canonical_values_.end()) return known->second;
+    return canonical_values_[key] = base.canonical_override(path, value.raw);
+  }
+
   /// The job at `pick`, its values made canonical and applied to the base scene. An impossible
-  /// value is reported at its line with the job's parameters.
-  SweepJob make_job(const Scene& base, const std::string& scene_hash, const std::vector<Axis>& axes,
-                    const std::vector<std::size_t>& pick, const Value& depth_default) const {
+  /// value is reported at its line with the job's parameters; values that are possible alone
+  /// but not together (e.g. an edge length and a width) at the line of the first.
+  SweepJob make_job(const SceneDocument& base, const std::string& scene_hash,
+                    const std::vector<Axis>& axes, const std::vector<std::size_t>& pick,
+                    const Value& depth_default) const {
     std::map<std::string, Value> chosen;
     for (std::size_t a = 0; a < axes.size(); ++a)
       for (std::size_t p = 0; p < axes[a].paths.size(); ++p)
@@ -272,12 +283,19 @@ class SweepReader {
         continue;
       }
       try {
-        job.overrides[path] = canonical_override(base, path, value.raw);
+        job.overrides[path] = canonical(base, path, value);
       } catch (const OverrideError& error) {
         fail_job(value, error.what());
       }
     }
-    apply_overrides(base, job.overrides);
+    // One override alone was read with its value by canonical(); several may clash.
+    if (job.overrides.size() > 1) {
+      try {
+        base.apply(job.overrides);
+      } catch (const OverrideError& error) {
+        fail_job(chosen.at(job.overrides.begin()->first), error.what());
+      }
+    }
     job.parameters = canonical_parameters(scene_hash, job.overrides, job.depth);
     job.id = job_id(job.parameters);
     return job;
@@ -285,6 +303,7 @@ class SweepReader {
 
   fs::path file_;
   toml::table document_;
+  mutable std::map<std::pair<std::string, std::string>, nlohmann::json> canonical_values_;
 };
 
 }  // namespace

@@ -1,8 +1,8 @@
 #pragma once
-// Sweep files (TOML, docs/sweep-format.md): a base scene and variations of its parameters,
-// expanded into jobs. Every job is validated by applying its overrides to the parsed scene
-// before anything is stored, so a bad value is reported at its line and no job of the sweep
-// is added.
+// Sweep files (TOML, docs/sweep-format.md): a base scene and variations of its numbers,
+// expanded into jobs. Every job is validated by putting its overrides into the base scene's
+// document and reading it (jobs/scene_overrides.hpp) before anything is stored, so a bad
+// value is reported at its line and no job of the sweep is added.
 
 #include <filesystem>
 #include <string>
@@ -39,10 +39,11 @@ struct Sweep {
 /// Throws InputError "file:line: message" for: TOML syntax errors, unknown keys (with the
 /// nearest valid key), a missing name or scene, a scene file that does not exist or is
 /// invalid (reported in the scene file), unknown parameter paths (with the nearest valid
-/// path), lists that are empty or not lists, zipped lists of different lengths, a path varied
-/// twice, two jobs with the same parameters, more than 10 000 jobs, and impossible values
-/// (reported at the value's line with the first job that has it, e.g. negative thickness,
-/// ν ≥ 0.5, depth 0).
+/// path) and paths to something other than a number, lists that are empty or not lists,
+/// zipped lists of different lengths, a path varied twice, two jobs with the same
+/// parameters, more than 10 000 jobs, and values the scene reader refuses (reported at the
+/// value's line with the first job that has it and the reader's rule, e.g. negative
+/// thickness, ν ≥ 0.5; depth 0).
 Sweep read_sweep(const std::filesystem::path& file);
 
 /// read_sweep on `text` as if it were the content of the sweep file `file` (which need not
