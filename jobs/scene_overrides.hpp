@@ -45,8 +45,9 @@ class SceneDocument {
   /// The scene file `file` whose content is `text` (the file need not exist). Throws as read.
   SceneDocument(std::string_view text, std::filesystem::path file);
 
-  /// The path of every number the file writes, in document order by key (for messages and
-  /// suggestions). Keys the file omits are paths too but are not listed.
+  /// The path of every number the file writes, each table's keys sorted and array elements
+  /// in order (for messages and suggestions). Keys the file omits are paths too but are not
+  /// listed.
   std::vector<std::string> numeric_paths() const;
 
   /// Throws OverrideError unless `path` names a number of the file or a key the scene format

@@ -21,6 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kDepth = "depth";
+/// A job's levels are its depth, which replaces the scene's [hierarchy] levels.
+const std::string kSceneLevels = "hierarchy.levels";
 
 /// Far more jobs than a sweep is run with; a larger product of the axes is almost surely a
 /// mistake (a long list in a [grid] meant for a [[zip]]), and expanding and validating it one
@@ -173,6 +175,10 @@ class SweepReader {
       const long line = values.front().line;
       if (!varied.insert(path).second)
         fail(line, fmt::format("parameter '{}' is varied twice; list it once", path));
+      if (path == kSceneLevels)
+        fail(line, fmt::format("'{}' has no effect in a job, whose levels are its depth; vary "
+                               "'{}' instead",
+                               kSceneLevels, kDepth));
       if (path != kDepth) {
         try {
           base.check_path(path);

@@ -39,11 +39,11 @@ struct Sweep {
 /// Throws InputError "file:line: message" for: TOML syntax errors, unknown keys (with the
 /// nearest valid key), a missing name or scene, a scene file that does not exist or is
 /// invalid (reported in the scene file), unknown parameter paths (with the nearest valid
-/// path) and paths to something other than a number, lists that are empty or not lists,
-/// zipped lists of different lengths, a path varied twice, two jobs with the same
-/// parameters, more than 10 000 jobs, and values the scene reader refuses (reported at the
-/// value's line with the first job that has it and the reader's rule, e.g. negative
-/// thickness, ν ≥ 0.5; depth 0).
+/// path), paths to something other than a number and `hierarchy.levels` (a job's levels are
+/// its depth), lists that are empty or not lists, zipped lists of different lengths, a path
+/// varied twice, two jobs with the same parameters, more than 10 000 jobs, and values the
+/// scene reader refuses (reported at the value's line with the first job that has it and the
+/// reader's rule, e.g. negative thickness, ν ≥ 0.5; depth 0).
 Sweep read_sweep(const std::filesystem::path& file);
 
 /// read_sweep on `text` as if it were the content of the sweep file `file` (which need not

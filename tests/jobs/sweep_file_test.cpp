@@ -214,6 +214,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadSweep{"[grid]\nshell.strip.mesh.edge_lenght = [1e-3]\n",
                  "did you mean 'shell.strip.mesh.edge_length'?", 4},
         BadSweep{"[grid]\n\"shell.strip.bending\" = [1]\n", "is a string in the scene", 4},
+        BadSweep{"[grid]\nhierarchy.levels = [1, 2]\n", "vary 'depth' instead", 4},
         BadSweep{"[grid]\n\"" + kH + "\" = [\"thick\"]\n", "must be a number", 4},
         BadSweep{"[grid]\n\"shell.strip.mesh.edge_length\" = [0.005,\n  0.05]\n",
                  "job depth=1 shell.strip.mesh.edge_length=0.05: parameter "

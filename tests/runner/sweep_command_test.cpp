@@ -83,6 +83,11 @@ TEST_F(SweepCommand, BadSweepFilesExitOneAndLeaveTheStoreAsItWas) {
       {"\"shell.strip.material.poisson_ratio\" = [0.5]\n", "(-1, 0.5)"},
       {"depth = [0]\n", "'depth' must be an integer"},
       {"\"shell.strip.material.thicknes\" = [1]\n", "did you mean"},
+      {"\"shell.strip.mesh.edge_lenght\" = [0.005]\n",
+       ":4: unknown parameter 'shell.strip.mesh.edge_lenght'; did you mean "
+       "'shell.strip.mesh.edge_length'?"},
+      {"\"shell.strip.mesh.edge_length\" = [0.05]\n",
+       "'edge_length' in [shell.mesh] must be smaller than the sheet's width and height"},
       {"\"time.frames\" = [3\n", "TOML syntax error"},
   };
   for (const auto& [grid, expected] : cases) {
