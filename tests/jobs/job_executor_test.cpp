@@ -8,13 +8,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
 #include "engine/io/part_meshes.hpp"
+#include "engine/scene/shell_mesh.hpp"
 #include "jobs/run_directory.hpp"
 #include "jobs/sweep_file.hpp"
 #include "support/test_paths.hpp"
@@ -400,6 +403,35 @@ TEST_F(Executor, ACancelledJobStopsAtItsNextHeartbeat) {
   };
   EXPECT_EQ(run(cancel_then_wait), jobs::RunOutcome::lease_lost);
   EXPECT_EQ(result().job.state, db::JobState::cancelled);
+}
+
+TEST(ExecutorScenes, TheResolutionSweepsJobsRunOnMeshesOfTheirEdgeLengths) {
+  const jobs::Sweep sweep = jobs::read_sweep(test::source_dir() / "jobs/sweeps/resolution.toml");
+  ASSERT_EQ(sweep.jobs.size(), 3u);
+  const fs::path dir = test::fresh_temp_dir("resolution_sweep");
+  db::JobStore store(dir / "psq.db");
+  store.add_sweep(sweep.name, sweep.file.string(), jobs::new_jobs(sweep));
+  int vertices = 0;  // of the scene the executor built for the job being run
+  const std::atomic<bool> stop{false};
+  jobs::JobExecutor executor(
+      store, dir / "psq.db", dir / "runs",
+      [&](const Scene& scene, int depth) {
+        vertices = build_shell_mesh(scene.shells.at(0).mesh).vertex_count();
+        return std::make_unique<ScriptedSolver>(depth, 1, 1);
+      },
+      {.snapshot_iterations = 1000, .snapshot_seconds = 1e9, .code_version = "test"}, {}, stop);
+  std::map<std::string, int> vertices_of_job;
+  while (const auto claim = store.claim_next({"w", "host", "test"}, 30.0)) {
+    ASSERT_EQ(executor.run(*claim), jobs::RunOutcome::done);
+    vertices_of_job[claim->job.id] = vertices;
+  }
+  ASSERT_EQ(vertices_of_job.size(), 3u);
+  // The 0.2 m × 0.02 m structured sheet has (0.2/h + 1)·(0.02/h + 1) vertices.
+  for (const jobs::SweepJob& job : sweep.jobs) {
+    const double h = job.overrides.at("shell.strip.mesh.edge_length").get<double>();
+    EXPECT_EQ(vertices_of_job.at(job.id), (std::lround(0.2 / h) + 1) * (std::lround(0.02 / h) + 1))
+        << "edge length " << h;
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "db/job_store.hpp"
@@ -69,6 +70,33 @@ TEST_F(WorkCommand, DeeperJobsRunLevelByLevelAndShareOneCachedHierarchy) {
   for (const auto& entry : fs::directory_iterator(db_.parent_path() / "cache"))
     cached += entry.path().extension() == ".bin";
   EXPECT_EQ(cached, 1);
+  expect_store_consistent();
+}
+
+TEST_F(WorkCommand, AResolutionSweepRunsEachMeshAndCachesAHierarchyForEach) {
+  // A small jobs/sweeps/resolution.toml: two edge lengths, two frames, two levels.
+  ASSERT_EQ(add_sweep("\"shell.strip.mesh.edge_length\" = [0.005, 0.0025]\n"
+                      "\"time.frames\" = [2]\ndepth = [2]\n"),
+            0)
+      << add_errors_;
+  const auto work = psq({"work", "--workers", "1"});
+  ASSERT_EQ(work.exit_code, 0) << work.errors;
+  const auto finished = results();
+  ASSERT_EQ(finished.size(), 2u);
+  for (const db::JobResult& r : finished) {
+    EXPECT_EQ(r.job.state, db::JobState::done);
+    ASSERT_EQ(r.levels.size(), 2u);
+    // The finest level is the 0.2 m × 0.02 m structured sheet at the job's edge length.
+    const double h = r.job.parameters.at("overrides").at("shell.strip.mesh.edge_length");
+    const Checkpoint fine = read_checkpoint(r.levels[1].checkpoint_path);
+    EXPECT_EQ(fine.positions.rows(), (std::lround(0.2 / h) + 1) * (std::lround(0.02 / h) + 1));
+    EXPECT_EQ(fine.frame, 2);
+  }
+  // The hierarchy is keyed on the mesh: each edge length has its own.
+  int cached = 0;
+  for (const auto& entry : fs::directory_iterator(db_.parent_path() / "cache"))
+    cached += entry.path().extension() == ".bin";
+  EXPECT_EQ(cached, 2);
   expect_store_consistent();
 }
 
