@@ -12,7 +12,8 @@ namespace psq::jobs {
 
 /// Scene parameter overrides by dotted path ("shell.cloth.material.thickness" → 5e-4). A std::map
 /// keeps the paths sorted, which the canonical form relies on. Values are canonical numbers:
-/// real parameters are stored as doubles and integer ones as integers (see apply_overrides).
+/// real parameters are stored as doubles and integer ones as integers (see
+/// SceneDocument::canonical_override, jobs/scene_overrides.hpp).
 using Overrides = std::map<std::string, nlohmann::json>;
 
 /// checksum_text of a file's bytes: "fnv1a64:<16 hex digits>". Throws InputError if it cannot

@@ -121,8 +121,9 @@ TEST(SceneOverrides, IntegersStayIntegersAndRealsTakeIntegers) {
   EXPECT_EQ(modulus.dump(), nlohmann::json(5e5).dump());
   // The file writes density = 1200 (an integer); it is still a real.
   EXPECT_TRUE(document.canonical_override("shell.strip.material.density", 900).is_number_float());
-  // A key the file omits: hierarchy.levels is an integer, hierarchy.vertex_ratio a real.
-  EXPECT_TRUE(document.canonical_override("hierarchy.levels", 3).is_number_integer());
+  // Keys the file omits: preview_iterations is an integer, contact.thickness a real.
+  EXPECT_TRUE(document.canonical_override("hierarchy.preview_iterations", 3).is_number_integer());
+  EXPECT_TRUE(document.canonical_override("contact.thickness", 0).is_number_float());
   EXPECT_NE(canonical_refusal(document, "time.frames", 2.5).find("expected an integer"),
             std::string::npos);
 }
