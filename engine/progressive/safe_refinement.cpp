@@ -190,6 +190,10 @@ bool vertex_patch_clean(const MixedMesh& mesh, const Positions& y, int vertex,
   return true;
 }
 
+bool contains(const std::vector<int>& vertices, int vertex) {
+  return std::find(vertices.begin(), vertices.end(), vertex) != vertices.end();
+}
+
 /// The fine vertices of the pairs (of bodies that may touch) of the mixed mesh, whose broad
 /// phase is `broad`, closer than `reach` at fine positions y.
 std::vector<int> close_vertices(const MixedMesh& mesh, const BroadPhase& broad, const Positions& y,
@@ -409,8 +413,8 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   };
   std::map<int, ClusterLayout> layouts;  // the last layout each cluster was placed by
   const Positions& fine_rest = fine.rest_mesh().vertices;
-  const auto place_into = [&](Positions& out, int k, const Eigen::Matrix3d& rotation,
-                              double radius, Layout layout) {
+  const auto place_into = [&](Positions& out, int k, const Eigen::Matrix3d& rotation, double radius,
+                              Layout layout) {
     const Eigen::Vector3d centre = row(coarse, k);
     Eigen::Vector3d origin = centre;
     if (layout == Layout::rest) {
@@ -420,9 +424,12 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
     }
     const auto offset = [&](int v) -> Eigen::Vector3d {
       switch (layout) {
-        case Layout::anchors: return row(anchor, v) - origin;
-        case Layout::targets: return row(goal, v) - origin;
-        case Layout::rest: break;
+        case Layout::anchors:
+          return row(anchor, v) - origin;
+        case Layout::targets:
+          return row(goal, v) - origin;
+        case Layout::rest:
+          break;
       }
       return row(fine_rest, v) - origin;
     };
@@ -562,6 +569,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
           if (representative[v] == removed) group.push_back(v);
         }
         const MixedMesh mixed(surface, representative);
+        const BroadPhase mixed_broad = mixed.broad_phase(surface.may_touch);
         const Eigen::Vector3d from = row(y, survivor);
         std::mt19937_64 random = seeded_random(level, removed, -1);
         std::normal_distribution<double> normal;
@@ -575,13 +583,19 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
           Eigen::Vector3d direction = toward_anchor;
           if (tries > 0 || !(direction.norm() > 0.0)) {
             const Eigen::Vector3d noise(normal(random), normal(random), normal(random));
-            const double spread = tries <= 1 ? 0.0 : static_cast<double>(tries) / kVertexDirectionTries;
+            const double spread =
+                tries <= 1 ? 0.0 : static_cast<double>(tries) / kVertexDirectionTries;
             direction = sector.normalized() + 2.0 * spread * noise.normalized();
             if (!(sector.norm() > 0.0) || !(direction.norm() > 0.0)) direction = noise;
           }
           const double reach = (tries <= 1 ? 1.0 : length(random)) * radius;
           for (int v : group) y.row(v) = (from + reach * direction.normalized()).transpose();
-          if (vertex_patch_clean(mixed, y, removed, surface.may_touch)) break;
+          // A split that leaves its vertex almost on another element passes the exact check on
+          // rounding alone (the patch folded flat onto its neighbours, 1e-17 m off their plane),
+          // and its gap would stall every later CCD advance.
+          if (vertex_patch_clean(mixed, y, removed, surface.may_touch) &&
+              !contains(close_vertices(mixed, mixed_broad, y, kSmallestShrunkGap * reach), removed))
+            break;
           ++stats.perturbation_retries;
           if (tries == kVertexDirectionTries)
             throw NumericalError(fmt::format(
