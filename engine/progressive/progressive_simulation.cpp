@@ -43,8 +43,8 @@ constexpr double kSettleProgress = 0.99;
 std::vector<TrianglePart> triangle_parts(const ShellSystem& system) {
   std::vector<TrianglePart> parts;
   for (const ShellBlock& shell : system.shells())
-    parts.push_back({fmt::format("shell '{}'", shell.name), shell.first_triangle,
-                     shell.triangle_count});
+    parts.push_back(
+        {fmt::format("shell '{}'", shell.name), shell.first_triangle, shell.triangle_count});
   for (const ColliderBlock& collider : system.colliders())
     parts.push_back({fmt::format("collider '{}'", collider.name), collider.first_triangle,
                      collider.triangle_count});
@@ -108,16 +108,16 @@ void ProgressiveSimulation::initialize() {
   const std::size_t colliders = finest_.colliders().size();
   if (!hierarchies_.empty() && hierarchies_.size() != shells &&
       hierarchies_.size() != shells + colliders)
-    throw std::invalid_argument(fmt::format(
-        "ProgressiveSimulation: {} hierarchies for {} shells and {} colliders",
-        hierarchies_.size(), shells, colliders));
+    throw std::invalid_argument(
+        fmt::format("ProgressiveSimulation: {} hierarchies for {} shells and {} colliders",
+                    hierarchies_.size(), shells, colliders));
   for (std::size_t k = 0; k < hierarchies_.size(); ++k) {
     const MeshBlock& block = k < shells ? finest_.shells()[k] : finest_.colliders()[k - shells];
     if (hierarchies_[k].levels.empty() ||
         hierarchies_[k].finest().rest.vertex_count() != block.vertex_count)
-      throw std::invalid_argument(fmt::format(
-          "ProgressiveSimulation: the hierarchy of {} '{}' does not end at its mesh",
-          k < shells ? "shell" : "collider", block.name));
+      throw std::invalid_argument(
+          fmt::format("ProgressiveSimulation: the hierarchy of {} '{}' does not end at its mesh",
+                      k < shells ? "shell" : "collider", block.name));
     if (k < shells) level_count_ = std::max(level_count_, hierarchies_[k].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
@@ -264,7 +264,8 @@ void ProgressiveSimulation::enter_level(int level) {
         level_newton_settings(level));
   }
   level_ = level;
-  // Level 0 starts at the rest state (frame 0); a finer level at the refine frame, to be settled.
+  // Level 0 starts at the rest state (frame 0); a finer level at the refine frame, to be settled
+  // (in a fixed-step scene: stepped once).
   settled_ = level == 0;
   settling_failed_ = false;
   settle_steps_ = 0;
@@ -283,10 +284,8 @@ bool ProgressiveSimulation::level_done() const {
 }
 
 bool ProgressiveSimulation::frame_settles(int frame) const {
-  const bool refine_frame_of_hierarchy = settles() && frame == refine_frame_;
-  const bool finest_equilibrium =
-      finest_level() && finest_.scene().solver.frame_solution == FrameSolution::equilibrium;
-  return refine_frame_of_hierarchy || finest_equilibrium;
+  if (!frames_are_equilibria()) return false;
+  return (settles() && frame == refine_frame_) || finest_level();
 }
 
 Eigen::VectorXd ProgressiveSimulation::finest_positions() const {
@@ -307,15 +306,23 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   const int iterations_done = std::exchange(resumed_iterations_, 0);
   if (iterations_done == 0) previous_ = x_;
   if (!out.settling && iterations_done == 0) frame_start_ = previous_;
-  out.frame = stepper_->step(previous_, x_, frame, time_step, iterations_done,
-                             [&](const NewtonIteration& it) {
-                               if (progress) progress(level_, frame, it);
-                             },
-                             frame_start_);
+  out.frame = stepper_->step(
+      previous_, x_, frame, time_step, iterations_done,
+      [&](const NewtonIteration& it) {
+        if (progress) progress(level_, frame, it);
+      },
+      frame_start_);
   out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
   const bool converged_at_start = out.frame.newton.converged && out.frame.newton.iterations == 0;
-  if (out.settling) {
+  if (out.settling && !frames_are_equilibria()) {
+    // The refine frame's step at a level entered by refinement: one step of Δt, as any frame of
+    // the path.
+    settled_ = true;
+    ++settle_steps_;
+    out.judged = finest_level();
+    out.converged = out.frame.newton.converged;
+  } else if (out.settling) {
     // At the finest level the step that ends a settling must itself be solved to the tolerance;
     // steps before it may stop at their budget on the way.
     const bool done = settling_done(settle_growth_, out.change, tolerance()) &&
@@ -377,8 +384,7 @@ void ProgressiveSimulation::refine(const RefinementProgress& progress) {
   const Eigen::VectorXd coarse = x_;
   const bool contact = contact_enabled(finest_.scene());
   const bool strain_limited = strain_limit_enabled(finest_.scene());
-  const Expansion expansion =
-      contact || strain_limited ? system_expansion(level_) : Expansion{};
+  const Expansion expansion = contact || strain_limited ? system_expansion(level_) : Expansion{};
   enter_level(level_ + 1);
   level_system().apply_pins(next, refine_frame_ * finest_.scene().time.step);
   std::optional<RefinementStats> safe_initialization;

@@ -1,6 +1,7 @@
 #pragma once
-// Progressive quasistatic simulation (paper §3, §4.4–4.5; DESIGN.md §6): previews at the coarsest level over the loading script, then refinement level by level at the
-// refine frame, and the true objective at the finest level to convergence.
+// Progressive quasistatic simulation (paper §3, §4.4–4.5; DESIGN.md §6): previews at the coarsest
+// level over the loading script, then refinement level by level at the refine frame, and the true
+// objective at the finest level to convergence.
 //
 // Schedule, one quasistatic step per call of step():
 //   level 0 (levels > 1): frames 1..refine_frame with the proxy objective, at most
@@ -60,7 +61,9 @@ std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
 /// One step of a progressive solve.
 struct ProgressiveStep {
   int level = 0;
-  /// A step at the refine frame with the loading held (frame.frame does not advance).
+  /// A step at the refine frame with the loading held (frame.frame does not advance): a
+  /// settling step, or in a fixed-step scene the refine frame's one step at a level entered by
+  /// refinement.
   bool settling = false;
   /// A settling step that passed the equilibrium test (settling_done): its frame is settled.
   bool equilibrium = false;
@@ -135,8 +138,12 @@ class ProgressiveSimulation {
   /// P^l(x_l) on the finest mesh; positions() itself at the finest level.
   [[nodiscard]] Eigen::VectorXd finest_positions() const;
 
-  /// Whether a step to `frame` at the current level is followed by settling steps: the refine
-  /// frame of a hierarchy, and every frame of the finest level whose frames are equilibria.
+  /// Whether a step to `frame` at the current level is followed by settling steps: when the
+  /// scene's frames are equilibria, the refine frame of a hierarchy and every frame of the
+  /// finest level. A fixed-step scene never settles: its path has no equilibrium to settle to
+  /// (a patch sliding down a slope) or the one settling reaches is not the path's (a twisted
+  /// sheet's layers); a level entered by refinement then takes the refine frame's one step of Δt
+  /// from its initializer.
   [[nodiscard]] bool frame_settles(int frame) const;
   /// One quasistatic step of the schedule. @throws std::logic_error when level_done().
   ProgressiveStep step(const Progress& progress = {});
@@ -191,6 +198,9 @@ class ProgressiveSimulation {
   void enter_level(int level);
   [[nodiscard]] NewtonSettings level_newton_settings(int level) const;
   [[nodiscard]] bool settles() const { return level_count_ > 1; }
+  [[nodiscard]] bool frames_are_equilibria() const {
+    return finest_.scene().solver.frame_solution == FrameSolution::equilibrium;
+  }
   /// Why the settling that just ended did not reach an equilibrium, for a step whose change
   /// was `change`.
   [[nodiscard]] std::string settling_failure_message(double change) const;

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "engine/contact/intersection_check.hpp"
@@ -19,6 +20,7 @@
 #include "engine/sim/quasistatic.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 #include "progressive/reference_runs.hpp"
+#include "support/library_scene.hpp"
 #include "support/press_scene.hpp"
 
 namespace psq {
@@ -139,8 +141,8 @@ std::size_t intersections(const ShellSystem& system, const Eigen::VectorXd& x) {
 struct ProgressiveRun {
   Eigen::VectorXd finest;
   bool converged = false;
-  std::size_t states = 0;          ///< states checked
-  std::size_t intersecting = 0;    ///< of those, states with an intersection
+  std::size_t states = 0;        ///< states checked
+  std::size_t intersecting = 0;  ///< of those, states with an intersection
   std::vector<RefinementStats> refinements;
 };
 
@@ -204,6 +206,13 @@ TEST(ProgressiveContact, TwistWithSelfContactIsIntersectionFreeAtEveryLevelAndCo
   const ProgressiveRun run = run_checked(scene_from(kTwist, "twist"), 2);
   expect_safe("twist", run, 2);
   EXPECT_TRUE(run.converged);
+  // The coarse twist is contact-free, so the expansion has room: no split may leave its vertex
+  // at rounding distance from another element (folded flat onto its neighbours, which the exact
+  // check cannot see), where the CCD advances stall short of their targets.
+  for (const RefinementStats& r : run.refinements) {
+    EXPECT_GT(r.smallest_gap, 1e-9);
+    EXPECT_LT(r.max_target_distance, 1e-2);
+  }
 }
 
 TEST(ProgressiveContact, CrushIsIntersectionFreeAtEveryLevelAndConverges) {
@@ -213,6 +222,49 @@ TEST(ProgressiveContact, CrushIsIntersectionFreeAtEveryLevelAndConverges) {
   // The expansion keeps the safe gap of the coarse state: no pair ends far closer than the
   // closest pair the level-0 solve left.
   for (const RefinementStats& r : run.refinements) EXPECT_GT(r.final_gap, 1e-2 * r.smallest_gap);
+}
+
+TEST(ProgressiveContact, AFixedStepSceneIsSteppedAtItsRefineFrameNotSettled) {
+  // The patch sliding down tilted_plane's slope (μ < tan α) has no equilibrium: settling it at
+  // growing pseudo time steps only slides it farther with every step. A fixed-step scene's
+  // finest level instead takes the refine frame's one step of Δt from its initializer, which
+  // for a rigid block is Δt² g (sin α − μ cos α) down the slope (tests/sim/friction_plane_test).
+  const Scene scene = test::library_scene("tilted_plane");
+  ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
+  settings.schedule.levels = 2;
+  ProgressiveSimulation sim(scene, settings);
+  const double alpha = scene.colliders.at(0).mesh.rotation_degrees * std::numbers::pi / 180;
+  const Eigen::Vector3d downhill(0, -std::cos(alpha), -std::sin(alpha));
+  std::vector<ProgressiveStep> finest_steps;
+  Eigen::VectorXd initializer;
+  for (;;) {
+    while (!sim.level_done()) {
+      ProgressiveStep step = sim.step();
+      EXPECT_TRUE(step.settling_failure.empty()) << step.settling_failure;
+      if (sim.finest_level()) finest_steps.push_back(std::move(step));
+    }
+    if (sim.finished()) break;
+    sim.refine();
+    initializer = sim.positions();
+  }
+  EXPECT_TRUE(sim.level_converged());
+  ASSERT_EQ(finest_steps.size(), 1u);  // the refine frame is the last frame
+  const ProgressiveStep& step = finest_steps.front();
+  EXPECT_TRUE(step.settling);
+  EXPECT_FALSE(step.equilibrium);
+  EXPECT_TRUE(step.judged);
+  EXPECT_TRUE(step.converged);
+  EXPECT_EQ(step.frame.frame, scene.time.frames);
+  EXPECT_EQ(intersections(sim.level_system(), sim.positions()), 0u);
+  const int patch_vertices = sim.level_system().shells()[0].vertex_count;
+  double slide = 0.0;
+  for (int v = 0; v < patch_vertices; ++v)
+    slide += (sim.positions() - initializer).segment<3>(3 * v).dot(downhill);
+  slide /= patch_vertices;
+  const double dt = scene.time.step;
+  const double coulomb_step =
+      dt * dt * 9.81 * (std::sin(alpha) - scene.contact.friction * std::cos(alpha));
+  EXPECT_NEAR(slide, coulomb_step, 0.05 * coulomb_step);
 }
 
 TEST(ProgressiveContact, CollidersAreDecimatedAndEndAtTheirScriptedPlaces) {
@@ -239,8 +291,7 @@ TEST(ProgressiveContact, CollidersAreDecimatedAndEndAtTheirScriptedPlaces) {
   check();
   const Positions coarse_ball = sim.level_system().collider_rest_mesh(0).vertices;
   for (Eigen::Index v = 0; v < coarse_ball.rows(); ++v) {
-    const double nearest =
-        (finest_ball.rowwise() - coarse_ball.row(v)).rowwise().norm().minCoeff();
+    const double nearest = (finest_ball.rowwise() - coarse_ball.row(v)).rowwise().norm().minCoeff();
     EXPECT_EQ(nearest, 0.0) << "coarse ball vertex " << v << " is not a vertex of the ball";
   }
   test::run_to_end(sim, check);
@@ -269,7 +320,8 @@ TEST(ProgressiveContact, PressMatchesTheDirectFineEquilibrium) {
   const ProgressiveRun progressive = run_checked(scene, 2);
   QuasistaticSimulation direct(scene);
   bool converged = true;
-  while (direct.frame() < direct.frame_count()) converged = direct.step().newton.converged && converged;
+  while (direct.frame() < direct.frame_count())
+    converged = direct.step().newton.converged && converged;
   ASSERT_TRUE(converged);
   const double diagonal = bounding_box_diagonal(direct.system().rest_mesh().vertices);
   const double distance = test::max_vertex_distance(progressive.finest, direct.positions());
@@ -306,8 +358,8 @@ TEST(ProgressiveContact, ResumingBetweenStepsEndsExactlyLikeTheUninterruptedRun)
     uninterrupted.refine();
   }
   ASSERT_GT(between_steps.size(), 6u);
-  for (const std::size_t k : {std::size_t{2}, level_zero_done, level_zero_done + 1,
-                              between_steps.size() - 2}) {
+  for (const std::size_t k :
+       {std::size_t{2}, level_zero_done, level_zero_done + 1, between_steps.size() - 2}) {
     SCOPED_TRACE(k);
     const Stored& stored = between_steps[k];
     ProgressiveSimulation resumed(scene, settings);
