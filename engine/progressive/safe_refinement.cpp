@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <random>
 #include <set>
 
@@ -36,8 +37,10 @@ constexpr int kClusterLayoutTries = 9;
 /// The smallest distance between elements of a shrunk layout, relative to its size: the rest
 /// layout, a piece of a good mesh, keeps about its edge ratio.
 constexpr double kSmallestShrunkGap = 1e-2;
-/// Random directions tried per vertex when a cluster is expanded one vertex at a time.
-constexpr int kVertexDirectionTries = 64;
+/// Directions tried per vertex when a cluster is expanded one vertex at a time: first about
+/// its anchor's offset and its sector, then spread evenly over the sphere.
+constexpr int kBiasedDirectionTries = 64;
+constexpr int kVertexDirectionTries = 512;
 /// ACCD ratio bounds (§4.4.2): pairs closer than g keep 99.9 % of their gap, others 10 %.
 constexpr double kCloseRatioBound = 0.999;
 constexpr double kFarRatioBound = 0.1;
@@ -188,6 +191,14 @@ bool vertex_patch_clean(const MixedMesh& mesh, const Positions& y, int vertex,
         may_touch(mesh.triangle_body[local[a]], mesh.triangle_body[local[b]]))
       return false;
   return true;
+}
+
+/// The i-th of n directions spread evenly over the unit sphere (a Fibonacci lattice).
+Eigen::Vector3d sphere_direction(int i, int n) {
+  const double golden_angle = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  const double z = 1.0 - (2.0 * i + 1.0) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {r * std::cos(golden_angle * i), r * std::sin(golden_angle * i), z};
 }
 
 bool contains(const std::vector<int>& vertices, int vertex) {
@@ -559,51 +570,98 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
         failing.insert(k);
       }
     }
+    // Splits `group` (the removed vertex and the vertices still merged into it) off the
+    // survivor, in the directions above; false, with the group back at the survivor, when none
+    // leaves the patch clean.
+    const auto split_off = [&](int removed, int survivor, const std::vector<int>& group) {
+      const MixedMesh mixed(surface, representative);
+      const BroadPhase mixed_broad = mixed.broad_phase(surface.may_touch);
+      const Eigen::Vector3d from = row(y, survivor);
+      std::mt19937_64 random = seeded_random(level, removed, -1);
+      std::normal_distribution<double> normal;
+      std::uniform_real_distribution<double> length(0.5, 1.0);
+      Eigen::Vector3d sector = Eigen::Vector3d::Zero();
+      for (int w : neighbours[removed])
+        if (representative[w] != representative[survivor] && representative[w] != removed)
+          sector += (row(y, representative[w]) - from).normalized();
+      const Eigen::Vector3d toward_anchor = row(anchor, removed) - row(anchor, survivor);
+      const Eigen::Matrix3d stratified_rotation =
+          Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random))
+              .normalized()
+              .toRotationMatrix();
+      for (int tries = 0; tries < kVertexDirectionTries; ++tries) {
+        Eigen::Vector3d direction = toward_anchor;
+        if (tries >= kBiasedDirectionTries) {
+          direction =
+              stratified_rotation * sphere_direction(tries - kBiasedDirectionTries,
+                                                     kVertexDirectionTries - kBiasedDirectionTries);
+        } else if (tries > 0 || !(direction.norm() > 0.0)) {
+          const Eigen::Vector3d noise(normal(random), normal(random), normal(random));
+          const double spread =
+              tries <= 1 ? 0.0 : static_cast<double>(tries) / kBiasedDirectionTries;
+          direction = sector.normalized() + 2.0 * spread * noise.normalized();
+          if (!(sector.norm() > 0.0) || !(direction.norm() > 0.0)) direction = noise;
+        }
+        const double reach = (tries <= 1 ? 1.0 : length(random)) * radius;
+        for (int v : group) y.row(v) = (from + reach * direction.normalized()).transpose();
+        // A split that leaves its vertex almost on another element passes the exact check on
+        // rounding alone (the patch folded flat onto its neighbours, 1e-17 m off their plane),
+        // and its gap would stall every later CCD advance.
+        if (vertex_patch_clean(mixed, y, removed, surface.may_touch) &&
+            !contains(close_vertices(mixed, mixed_broad, y, kSmallestShrunkGap * reach), removed))
+          return true;
+        ++stats.perturbation_retries;
+      }
+      for (int v : group) y.row(v) = from.transpose();
+      return false;
+    };
+    const auto update_representatives = [&](int k) {
+      for (int v : children[k]) representative[v] = root(v);
+    };
+    // Splits the removed vertex of a collapse off its survivor: with the vertices still merged
+    // into it, else alone (a fan folded about the survivor can leave no direction in which the
+    // group's whole wedge of triangles parts from the rest; its other vertices then stay with
+    // the survivor, to split off later each with its own smaller wedge), else alone off another
+    // expanded neighbour in the cluster. False, with the vertex merged into its survivor again,
+    // when none works.
+    const auto split = [&](int k, int removed, int survivor) {
+      merged_into[removed] = -1;
+      update_representatives(k);
+      std::vector<int> group;
+      for (int v : children[k])
+        if (representative[v] == removed) group.push_back(v);
+      if (split_off(removed, survivor, group)) return true;
+      for (int v : group)
+        if (v != removed) merged_into[v] = survivor;
+      update_representatives(k);
+      if (group.size() > 1 && split_off(removed, survivor, {removed})) return true;
+      for (int w : neighbours[removed]) {
+        if (w == survivor || parent[w] != k || representative[w] != w) continue;
+        y.row(removed) = y.row(w);
+        if (split_off(removed, w, {removed})) return true;
+      }
+      merged_into[removed] = survivor;
+      update_representatives(k);
+      y.row(removed) = y.row(survivor);
+      return false;
+    };
     for (int k : failing) {
-      for (auto c = cluster_collapses[k].rbegin(); c != cluster_collapses[k].rend(); ++c) {
-        const auto [removed, survivor] = collapses[*c];
-        merged_into[removed] = -1;
-        std::vector<int> group;  // removed and the vertices still merged into it
-        for (int v : children[k]) {
-          representative[v] = root(v);
-          if (representative[v] == removed) group.push_back(v);
-        }
-        const MixedMesh mixed(surface, representative);
-        const BroadPhase mixed_broad = mixed.broad_phase(surface.may_touch);
-        const Eigen::Vector3d from = row(y, survivor);
-        std::mt19937_64 random = seeded_random(level, removed, -1);
-        std::normal_distribution<double> normal;
-        std::uniform_real_distribution<double> length(0.5, 1.0);
-        Eigen::Vector3d sector = Eigen::Vector3d::Zero();
-        for (int w : neighbours[removed])
-          if (representative[w] != representative[survivor] && representative[w] != removed)
-            sector += (row(y, representative[w]) - from).normalized();
-        const Eigen::Vector3d toward_anchor = row(anchor, removed) - row(anchor, survivor);
-        for (int tries = 0;; ++tries) {
-          Eigen::Vector3d direction = toward_anchor;
-          if (tries > 0 || !(direction.norm() > 0.0)) {
-            const Eigen::Vector3d noise(normal(random), normal(random), normal(random));
-            const double spread =
-                tries <= 1 ? 0.0 : static_cast<double>(tries) / kVertexDirectionTries;
-            direction = sector.normalized() + 2.0 * spread * noise.normalized();
-            if (!(sector.norm() > 0.0) || !(direction.norm() > 0.0)) direction = noise;
-          }
-          const double reach = (tries <= 1 ? 1.0 : length(random)) * radius;
-          for (int v : group) y.row(v) = (from + reach * direction.normalized()).transpose();
-          // A split that leaves its vertex almost on another element passes the exact check on
-          // rounding alone (the patch folded flat onto its neighbours, 1e-17 m off their plane),
-          // and its gap would stall every later CCD advance.
-          if (vertex_patch_clean(mixed, y, removed, surface.may_touch) &&
-              !contains(close_vertices(mixed, mixed_broad, y, kSmallestShrunkGap * reach), removed))
-            break;
-          ++stats.perturbation_retries;
-          if (tries == kVertexDirectionTries)
-            throw NumericalError(fmt::format(
-                "refinement to level {}: no intersection-free perturbation of level-{} vertex "
-                "{} found in {} tries while expanding level-{} vertex {}; use fewer levels or "
-                "a larger [hierarchy] vertex_ratio",
-                level, level, removed, kVertexDirectionTries, level - 1, k));
-        }
+      // Latest collapse first; a split that fails waits until the cluster's other splits have
+      // changed its neighbourhood, and is tried again while any of them succeeds.
+      std::vector<std::array<int, 2>> waiting;
+      for (auto c = cluster_collapses[k].rbegin(); c != cluster_collapses[k].rend(); ++c)
+        if (!split(k, collapses[*c][0], collapses[*c][1])) waiting.push_back(collapses[*c]);
+      while (!waiting.empty()) {
+        std::vector<std::array<int, 2>> still;
+        for (const auto& [removed, survivor] : waiting)
+          if (!split(k, removed, survivor)) still.push_back({removed, survivor});
+        if (still.size() == waiting.size())
+          throw NumericalError(fmt::format(
+              "refinement to level {}: no intersection-free perturbation of level-{} vertex {} "
+              "found in {} tries while expanding level-{} vertex {}; use fewer levels or a "
+              "larger [hierarchy] vertex_ratio",
+              level, level, still.front()[0], kVertexDirectionTries, level - 1, k));
+        waiting = std::move(still);
       }
     }
     const MixedMesh mixed(surface, representative);
