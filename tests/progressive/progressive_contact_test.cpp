@@ -9,7 +9,6 @@
 #include <iostream>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <string>
 
 #include "engine/contact/intersection_check.hpp"
@@ -22,6 +21,7 @@
 #include "progressive/reference_runs.hpp"
 #include "support/library_scene.hpp"
 #include "support/press_scene.hpp"
+#include "support/slope.hpp"
 
 namespace psq {
 namespace {
@@ -228,13 +228,12 @@ TEST(ProgressiveContact, AFixedStepSceneIsSteppedAtItsRefineFrameNotSettled) {
   // The patch sliding down tilted_plane's slope (μ < tan α) has no equilibrium: settling it at
   // growing pseudo time steps only slides it farther with every step. A fixed-step scene's
   // finest level instead takes the refine frame's one step of Δt from its initializer, which
-  // for a rigid block is Δt² g (sin α − μ cos α) down the slope (tests/sim/friction_plane_test).
+  // for a rigid block is Δt² g (sin α − μ cos α) down the slope (tests/support/slope.hpp).
   const Scene scene = test::library_scene("tilted_plane");
   ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
   settings.schedule.levels = 2;
   ProgressiveSimulation sim(scene, settings);
-  const double alpha = scene.colliders.at(0).mesh.rotation_degrees * std::numbers::pi / 180;
-  const Eigen::Vector3d downhill(0, -std::cos(alpha), -std::sin(alpha));
+  const Eigen::Vector3d downhill = test::downhill(scene);
   std::vector<ProgressiveStep> finest_steps;
   Eigen::VectorXd initializer;
   for (;;) {
@@ -261,9 +260,7 @@ TEST(ProgressiveContact, AFixedStepSceneIsSteppedAtItsRefineFrameNotSettled) {
   for (int v = 0; v < patch_vertices; ++v)
     slide += (sim.positions() - initializer).segment<3>(3 * v).dot(downhill);
   slide /= patch_vertices;
-  const double dt = scene.time.step;
-  const double coulomb_step =
-      dt * dt * 9.81 * (std::sin(alpha) - scene.contact.friction * std::cos(alpha));
+  const double coulomb_step = test::coulomb_step(scene, scene.contact.friction);
   EXPECT_NEAR(slide, coulomb_step, 0.05 * coulomb_step);
 }
 

@@ -9,28 +9,22 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 
 #include "engine/scene/scene_reader.hpp"
 #include "support/library_scene.hpp"
 #include "support/scene_run.hpp"
+#include "support/slope.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
 
-constexpr double kGravity = 9.81;  // m/s², the scene's
 constexpr int kFrames = 5;
 
 Scene tilted_plane() {
   Scene scene = test::library_scene("tilted_plane");
   scene.time.frames = kFrames;
   return scene;
-}
-
-/// α, the slope's tilt (its rotation about x).
-double slope_angle(const Scene& scene) {
-  return scene.colliders.at(0).mesh.rotation_degrees * std::numbers::pi / 180;
 }
 
 /// A run on the slope: the patch's mean displacement down the slope after each frame.
@@ -42,8 +36,7 @@ struct SlopeRun {
 };
 
 SlopeRun run_on_slope(const Scene& scene) {
-  const double alpha = slope_angle(scene);
-  const Eigen::Vector3d downhill(0, -std::cos(alpha), -std::sin(alpha));
+  const Eigen::Vector3d downhill = test::downhill(scene);
   SlopeRun out;
   Eigen::VectorXd start;
   out.run = test::simulate(scene, [&](const QuasistaticSimulation& sim) {
@@ -64,13 +57,6 @@ double frame_step(const SlopeRun& slope, int k) {
   return slope.downhill[k - 1] - (k == 1 ? 0.0 : slope.downhill[k - 2]);
 }
 
-/// Δt² g (sin α − μ cos α): a rigid block's quasistatic step down the slope.
-double coulomb_step(const Scene& scene, double mu) {
-  const double alpha = slope_angle(scene);
-  const double dt = scene.time.step;
-  return dt * dt * kGravity * (std::sin(alpha) - mu * std::cos(alpha));
-}
-
 void expect_friction_loop_ran(const test::SceneRun& run) {
   test::expect_intersection_free_and_converged(run);
   for (const FrameRecord& f : run.frames) {
@@ -84,7 +70,8 @@ TEST(FrictionOnSlope, PatchSticksWhenMuExceedsTanAlpha) {
   Scene scene = tilted_plane();
   // Through the per-pair override: the scene-wide μ alone would let the patch slide.
   scene.contact.friction = 0;
-  scene.contact.pair_friction.push_back({{"patch", "slope"}, 1.3 * std::tan(slope_angle(scene))});
+  scene.contact.pair_friction.push_back(
+      {{"patch", "slope"}, 1.3 * std::tan(test::slope_angle(scene))});
   const SlopeRun slope = run_on_slope(scene);
   expect_friction_loop_ran(slope.run);
   ASSERT_TRUE(slope.has_friction_term);
@@ -100,11 +87,11 @@ TEST(FrictionOnSlope, PatchSticksWhenMuExceedsTanAlpha) {
 
 TEST(FrictionOnSlope, PatchSlidesByTheCoulombStepWhenMuIsBelowTanAlpha) {
   Scene scene = tilted_plane();
-  const double mu = 0.7 * std::tan(slope_angle(scene));
+  const double mu = 0.7 * std::tan(test::slope_angle(scene));
   scene.contact.friction = mu;
   const SlopeRun slope = run_on_slope(scene);
   expect_friction_loop_ran(slope.run);
-  const double expected = coulomb_step(scene, mu);
+  const double expected = test::coulomb_step(scene, mu);
   // Sticking contacts creep by less than ε per frame, so steps beyond 10 ε are real sliding.
   ASSERT_GT(expected, 10 * slope.slip_threshold);
   for (int k = 1; k <= kFrames; ++k) {
@@ -121,7 +108,7 @@ TEST(FrictionOnSlope, WithoutFrictionThereIsNoTermAndThePatchSlidesFreely) {
   test::expect_intersection_free_and_converged(slope.run);
   EXPECT_FALSE(slope.has_friction_term);
   for (const FrameRecord& f : slope.run.frames) EXPECT_EQ(f.friction_iterations, 0);
-  const double expected = coulomb_step(scene, 0);
+  const double expected = test::coulomb_step(scene, 0);
   for (int k = 1; k <= kFrames; ++k)
     EXPECT_NEAR(frame_step(slope, k), expected, 0.05 * expected) << "frame " << k;
 }
