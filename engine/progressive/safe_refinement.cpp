@@ -605,8 +605,8 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
         const double reach = (tries <= 1 ? 1.0 : length(random)) * radius;
         for (int v : group) y.row(v) = (from + reach * direction.normalized()).transpose();
         // A split that leaves its vertex almost on another element passes the exact check on
-        // rounding alone (the patch folded flat onto its neighbours, 1e-17 m off their plane),
-        // and its gap would stall every later CCD advance.
+        // rounding alone (the patch folded flat onto its neighbours, a rounding error off their
+        // plane), and its gap would stall every later CCD advance.
         if (vertex_patch_clean(mixed, y, removed, surface.may_touch) &&
             !contains(close_vertices(mixed, mixed_broad, y, kSmallestShrunkGap * reach), removed))
           return true;
