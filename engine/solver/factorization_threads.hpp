@@ -18,6 +18,10 @@
 // the same benchmark on a quiet machine, factorization ms per Newton iteration, parallel →
 // serial: 1.1k 18 → 8, 5.3k 124 → 68, 21k 615 → 350.
 //
+// Even serial, a libgomp region allocates a team and wakes its barrier with a futex call, about
+// 10,000 system calls per factorization of a 10k-vertex shell; so a region the runtime would
+// run on one thread is run as a plain call (GOMP_parallel in factorization_threads.cpp).
+//
 // So PSQ factorizes single-threaded unless the user says otherwise.
 
 namespace psq {
