@@ -392,7 +392,7 @@ void ContactPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& blocks
   ScopedTimer timer(stats_.barrier_seconds);
   tbb::parallel_for(std::size_t{0}, active_.size(), [&](std::size_t k) {
     Eigen::Matrix<double, 12, 12> h = pair_derivatives(active_[k], x, parameters_.band).hessian;
-    if (project_psd) project_to_psd(h);
+    if (project_psd) project_translation_invariant_to_psd(h);
     blocks.block(k) = stiffness_ * h;
   });
 }

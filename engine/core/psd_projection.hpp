@@ -6,8 +6,16 @@ namespace psq {
 /// Replaces a symmetric matrix by its closest positive semi-definite matrix (negative
 /// eigenvalues clamped to zero), so Newton directions stay descent directions.
 void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric);
-/// The same for a contact pair's 12×12 block, with a fixed-size eigensolver: it runs once per
-/// pair within reach per Hessian, and the dynamic one allocates.
-void project_to_psd(Eigen::Matrix<double, 12, 12>& symmetric);
+
+/// The same projection for the 12×12 Hessian of a function of four points that a common
+/// translation leaves unchanged (a contact pair's barrier: distances and the edge-edge
+/// mollifier). Such a Hessian maps every translation to zero, so in an orthonormal basis that
+/// splits the translations off it is 0 ⊕ R with R of size 3(m − 1), m the number of points it
+/// depends on (those whose rows are not all zero: 2 for a point-point distance, 3 for a
+/// point-edge one). Projection commutes with an orthogonal change of basis, so projecting R
+/// gives the full projection up to rounding, with an eigensolver of at most 9×9 instead of
+/// 12×12: the eigensolver was a fifth of the samples of a settled 10k-vertex drape
+/// (docs/benchmarks.md).
+void project_translation_invariant_to_psd(Eigen::Matrix<double, 12, 12>& hessian);
 
 }  // namespace psq

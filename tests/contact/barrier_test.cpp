@@ -6,10 +6,12 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "engine/contact/edge_edge_distance.hpp"
 #include "engine/contact/point_triangle_distance.hpp"
 #include "engine/core/error.hpp"
+#include "engine/core/psd_projection.hpp"
 #include "support/derivative_check.hpp"
 #include "support/random_geometry.hpp"
 
@@ -251,6 +253,28 @@ TEST(BarrierStiffness, CatchesUpWithTheForceWhereTheCcdCutsStepsAtAStalledGap) {
   // Never beyond κ_max.
   EXPECT_EQ(update_barrier_stiffness({1e6, 1e7}, 1e-24, 1e-24, 2, {1e-3, 0}, 1e-9, true).value,
             1e7);
+}
+
+TEST(Barrier, PairHessiansProjectInTheirRelativeMotionsLikeTheFullEigensolver) {
+  // Point-triangle pairs in the triangle's interior, edge and vertex regions (12, 9 and 6
+  // coordinates the distance depends on) and a crossing edge-edge pair, all within the band.
+  const BarrierBand band{0.5, 0};
+  const Eigen::Vector3d t0(0, 0, 0), t1(1, 0, 0), t2(0, 1, 0);
+  std::vector<StencilDerivatives<12>> pairs;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.2, 0.3, 0.2), Eigen::Vector3d(0.5, -0.2, 0.2),
+                                  Eigen::Vector3d(-0.2, -0.1, 0.2)})
+    pairs.push_back(barrier_of_distance(point_triangle_distance_derivatives(p, t0, t1, t2), band));
+  pairs.push_back(barrier_of_distance(
+      edge_edge_distance_derivatives(t0, t1, Eigen::Vector3d(0.4, -0.5, 0.25),
+                                     Eigen::Vector3d(0.6, 0.5, 0.3)),
+      band));
+  for (const StencilDerivatives<12>& pair : pairs) {
+    Eigen::Matrix<double, 12, 12> reduced = pair.hessian;
+    Eigen::MatrixXd full = pair.hessian;
+    project_translation_invariant_to_psd(reduced);
+    project_to_psd(full);
+    EXPECT_LT((reduced - full).norm(), 1e-12 * full.norm());
+  }
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cstdlib>
+#include <vector>
 
 #include "engine/core/psd_projection.hpp"
 
@@ -24,18 +26,54 @@ TEST(PsdProjection, LeavesPositiveSemiDefiniteMatricesUnchanged) {
   EXPECT_EQ(m, before);
 }
 
-TEST(PsdProjection, FixedSizeBlocksProjectLikeDynamicOnes) {
-  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(12, 12);
-  Eigen::Matrix<double, 12, 12> fixed = a + a.transpose();
-  Eigen::MatrixXd dynamic = fixed;
-  ASSERT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dynamic).eigenvalues().minCoeff(), 0.0);
-  project_to_psd(fixed);
-  project_to_psd(dynamic);
-  EXPECT_LT((fixed - dynamic).norm(), 1e-12 * dynamic.norm());
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(fixed))
-                .eigenvalues()
-                .minCoeff(),
-            -1e-12 * dynamic.norm());
+/// The Hessian Dᵀ A D of a function of the positions of the given points relative to the
+/// first of them (D maps the 12 coordinates to those differences), with A a random symmetric
+/// matrix: translation-invariant, and indefinite for most A.
+Eigen::Matrix<double, 12, 12> translation_invariant_hessian(const std::vector<int>& points,
+                                                            unsigned seed) {
+  std::srand(seed);
+  const int n = 3 * (static_cast<int>(points.size()) - 1);
+  Eigen::MatrixXd differences = Eigen::MatrixXd::Zero(n, 12);
+  for (int k = 1; k < static_cast<int>(points.size()); ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      differences(3 * (k - 1) + axis, 3 * points[k] + axis) = 1;
+      differences(3 * (k - 1) + axis, 3 * points[0] + axis) = -1;
+    }
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n);
+  return differences.transpose() * (a + a.transpose()) * differences;
+}
+
+double smallest_eigenvalue(const Eigen::MatrixXd& m) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(m).eigenvalues().minCoeff();
+}
+
+TEST(PsdProjection, TranslationInvariantBlocksProjectLikeTheFullEigensolver) {
+  // Four points, and the fewer a point-point or point-edge distance depends on (in any slots).
+  const std::vector<std::vector<int>> cases = {{0, 1, 2, 3}, {0, 2, 3}, {1, 3}, {3, 0, 1}};
+  unsigned seed = 1;
+  for (const std::vector<int>& points : cases) {
+    Eigen::Matrix<double, 12, 12> reduced = translation_invariant_hessian(points, seed++);
+    Eigen::MatrixXd full = reduced;
+    ASSERT_LT(smallest_eigenvalue(full), -1e-3 * full.norm());
+    project_translation_invariant_to_psd(reduced);
+    project_to_psd(full);
+    EXPECT_LT((reduced - full).norm(), 1e-12 * full.norm()) << points.size() << " points";
+    EXPECT_GT(smallest_eigenvalue(reduced), -1e-12 * full.norm());
+  }
+}
+
+TEST(PsdProjection, TranslationInvariantPositiveSemiDefiniteBlocksStayUnchanged) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(9, 9);
+  Eigen::MatrixXd differences = Eigen::MatrixXd::Zero(9, 12);
+  for (int k = 1; k < 4; ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      differences(3 * (k - 1) + axis, 3 * k + axis) = 1;
+      differences(3 * (k - 1) + axis, axis) = -1;
+    }
+  Eigen::Matrix<double, 12, 12> m = differences.transpose() * a * a.transpose() * differences;
+  const Eigen::Matrix<double, 12, 12> before = m;
+  project_translation_invariant_to_psd(m);
+  EXPECT_EQ(m, before);
 }
 
 }  // namespace
