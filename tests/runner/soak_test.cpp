@@ -57,7 +57,7 @@ int positive_from_environment(const char* name, int fallback) {
 int kill_count() { return positive_from_environment("PSQ_SOAK_KILLS", 15); }
 unsigned seed() { return static_cast<unsigned>(positive_from_environment("PSQ_SOAK_SEED", 1)); }
 
-/// A workspace with the soak sweep: the cantilever over 20 frames (twice the scene's, so that a
+/// A workspace with the soak sweep: the cantilever over 40 frames (four times the scene's, so that a
 /// job lasts through a few signals) at depths 1 and 2, `thicknesses` thicknesses.
 struct SoakSweep : test::CantileverWorkspace {
   SoakSweep(const std::string& name, int thicknesses) : CantileverWorkspace(name) {
@@ -67,7 +67,7 @@ struct SoakSweep : test::CantileverWorkspace {
     const test::ProcessResult added =
         add_sweep("soak", fmt::format("depth = [1, 2]\n\"shell.strip.material.thickness\" = [{}]\n"
                                       "\"shell.strip.material.youngs_modulus\" = [5e6]\n"
-                                      "\"time.frames\" = [20]\n",
+                                      "\"time.frames\" = [40]\n",
                                       values));
     EXPECT_EQ(added.exit_code, 0) << added.errors;
   }
