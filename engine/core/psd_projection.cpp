@@ -18,12 +18,12 @@ void clamp_negative_eigenvalues(Symmetric& symmetric) {
 
 /// Orthonormal basis (columns) of the motions of the given points with no common translation:
 /// Helmert's contrasts, column block k − 1 moving points 0..k−1 by 1/√(k(k+1)) and point k by
-/// −k/√(k(k+1)), each along one axis.
-Eigen::Matrix<double, 12, Eigen::Dynamic, 0, 12, 9> relative_motion_basis(
-    const std::array<int, 4>& points, int count) {
-  Eigen::Matrix<double, 12, Eigen::Dynamic, 0, 12, 9> basis =
-      Eigen::Matrix<double, 12, Eigen::Dynamic, 0, 12, 9>::Zero(12, 3 * (count - 1));
-  for (int k = 1; k < count; ++k) {
+/// −k/√(k(k+1)), each along one axis. Fixed sizes: Eigen's products of dynamic ones, even
+/// bounded, go through its general kernel, which cost more than the eigensolver saved.
+template <int Relative>
+Eigen::Matrix<double, 12, Relative> relative_motion_basis(const std::array<int, 4>& points) {
+  Eigen::Matrix<double, 12, Relative> basis = Eigen::Matrix<double, 12, Relative>::Zero();
+  for (int k = 1; k <= Relative / 3; ++k) {
     const double scale = 1.0 / std::sqrt(double(k) * (k + 1));
     for (int axis = 0; axis < 3; ++axis) {
       const int column = 3 * (k - 1) + axis;
@@ -32,6 +32,19 @@ Eigen::Matrix<double, 12, Eigen::Dynamic, 0, 12, 9> relative_motion_basis(
     }
   }
   return basis;
+}
+
+/// Projects `hessian` through its block R over the relative motions of `points`.
+template <int Relative>
+void project_relative_block(Eigen::Matrix<double, 12, 12>& hessian,
+                            const std::array<int, 4>& points) {
+  const Eigen::Matrix<double, 12, Relative> basis = relative_motion_basis<Relative>(points);
+  const Eigen::Matrix<double, Relative, Relative> relative = basis.transpose() * hessian * basis;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Relative, Relative>> eig(relative);
+  const auto& lambda = eig.eigenvalues();
+  if (lambda.minCoeff() >= 0.0) return;
+  const Eigen::Matrix<double, 12, Relative> modes = basis * eig.eigenvectors();
+  hessian = modes * lambda.cwiseMax(0.0).asDiagonal() * modes.transpose();
 }
 
 }  // namespace
@@ -50,15 +63,11 @@ void project_translation_invariant_to_psd(Eigen::Matrix<double, 12, 12>& hessian
     hessian.setZero();
     return;
   }
-  const auto basis = relative_motion_basis(points, count);
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 9, 9> relative =
-      basis.transpose() * hessian * basis;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 9, 9>>
-      eig(relative);
-  const auto& lambda = eig.eigenvalues();
-  if (lambda.minCoeff() >= 0.0) return;
-  const auto modes = (basis * eig.eigenvectors()).eval();
-  hessian = modes * lambda.cwiseMax(0.0).asDiagonal() * modes.transpose();
+  switch (count) {
+    case 2: project_relative_block<3>(hessian, points); break;
+    case 3: project_relative_block<6>(hessian, points); break;
+    default: project_relative_block<9>(hessian, points); break;
+  }
 }
 
 }  // namespace psq
