@@ -227,12 +227,14 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
   const BroadPhase broad = mesh.broad_phase(may_touch);
   Positions p = mesh.positions(y);
   Positions d = mesh.positions(delta);
+  // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion. Each
+  // round's motion lies within the first one's (a vertex goes on along its segment, or stops
+  // on it), so the first round's candidates serve them all.
+  const std::vector<ContactPair> pairs =
+      candidate_pairs(broad.swept_candidates(p, p + d, ccd.min_distance + gap), broad);
   int rounds = 0;
   for (; rounds < kMaxAdvanceRounds && !d.isZero(0.0); ++rounds) {
     const Positions end = p + d;
-    // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion.
-    const ContactCandidates candidates = broad.swept_candidates(p, end, ccd.min_distance + gap);
-    const std::vector<ContactPair> pairs = candidate_pairs(candidates, broad);
     const Eigen::VectorXd x0 = flat(p), x1 = flat(end);
     const auto moving = [&](const std::array<int, 4>& vertices) {
       for (int v : vertices)
