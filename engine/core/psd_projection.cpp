@@ -7,19 +7,22 @@
 namespace psq {
 namespace {
 
+/// Clamps the negative eigenvalues of `symmetric` to zero; returns whether there were any (a
+/// positive semi-definite matrix is left exactly as it was).
 template <class Symmetric>
-void clamp_negative_eigenvalues(Symmetric& symmetric) {
+bool clamp_negative_eigenvalues(Symmetric& symmetric) {
   Eigen::SelfAdjointEigenSolver<typename Symmetric::PlainObject> eig(symmetric);
   const auto& lambda = eig.eigenvalues();
-  if (lambda.minCoeff() >= 0.0) return;
+  if (lambda.minCoeff() >= 0.0) return false;
   symmetric =
       eig.eigenvectors() * lambda.cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  return true;
 }
 
 /// Orthonormal basis (columns) of the motions of the given points with no common translation:
 /// Helmert's contrasts, column block k − 1 moving points 0..k−1 by 1/√(k(k+1)) and point k by
-/// −k/√(k(k+1)), each along one axis. Fixed sizes: Eigen's products of dynamic ones, even
-/// bounded, go through its general kernel, which cost more than the eigensolver saved.
+/// −k/√(k(k+1)), each along one axis. Fixed sizes, so that Eigen's products are unrolled
+/// rather than run through its general matrix kernel.
 template <int Relative>
 Eigen::Matrix<double, 12, Relative> relative_motion_basis(const std::array<int, 4>& points) {
   Eigen::Matrix<double, 12, Relative> basis = Eigen::Matrix<double, 12, Relative>::Zero();
@@ -39,12 +42,8 @@ template <int Relative>
 void project_relative_block(Eigen::Matrix<double, 12, 12>& hessian,
                             const std::array<int, 4>& points) {
   const Eigen::Matrix<double, 12, Relative> basis = relative_motion_basis<Relative>(points);
-  const Eigen::Matrix<double, Relative, Relative> relative = basis.transpose() * hessian * basis;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Relative, Relative>> eig(relative);
-  const auto& lambda = eig.eigenvalues();
-  if (lambda.minCoeff() >= 0.0) return;
-  const Eigen::Matrix<double, 12, Relative> modes = basis * eig.eigenvectors();
-  hessian = modes * lambda.cwiseMax(0.0).asDiagonal() * modes.transpose();
+  Eigen::Matrix<double, Relative, Relative> relative = basis.transpose() * hessian * basis;
+  if (clamp_negative_eigenvalues(relative)) hessian = basis * relative * basis.transpose();
 }
 
 }  // namespace

@@ -14,8 +14,7 @@ void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric);
 /// depends on (those whose rows are not all zero: 2 for a point-point distance, 3 for a
 /// point-edge one). Projection commutes with an orthogonal change of basis, so projecting R
 /// gives the full projection up to rounding, with an eigensolver of at most 9×9 instead of
-/// 12×12: the eigensolver was a fifth of the samples of a settled 10k-vertex drape
-/// (docs/benchmarks.md).
+/// 12×12 (its speed-up: docs/benchmarks.md).
 void project_translation_invariant_to_psd(Eigen::Matrix<double, 12, 12>& hessian);
 
 }  // namespace psq

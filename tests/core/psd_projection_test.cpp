@@ -26,12 +26,9 @@ TEST(PsdProjection, LeavesPositiveSemiDefiniteMatricesUnchanged) {
   EXPECT_EQ(m, before);
 }
 
-/// The Hessian Dᵀ A D of a function of the positions of the given points relative to the
-/// first of them (D maps the 12 coordinates to those differences), with A a random symmetric
-/// matrix: translation-invariant, and indefinite for most A.
-Eigen::Matrix<double, 12, 12> translation_invariant_hessian(const std::vector<int>& points,
-                                                            unsigned seed) {
-  std::srand(seed);
+/// D, which maps the 12 coordinates of four points to the positions of the given points
+/// relative to the first of them.
+Eigen::MatrixXd relative_positions(const std::vector<int>& points) {
   const int n = 3 * (static_cast<int>(points.size()) - 1);
   Eigen::MatrixXd differences = Eigen::MatrixXd::Zero(n, 12);
   for (int k = 1; k < static_cast<int>(points.size()); ++k)
@@ -39,7 +36,16 @@ Eigen::Matrix<double, 12, 12> translation_invariant_hessian(const std::vector<in
       differences(3 * (k - 1) + axis, 3 * points[k] + axis) = 1;
       differences(3 * (k - 1) + axis, 3 * points[0] + axis) = -1;
     }
-  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n);
+  return differences;
+}
+
+/// The Hessian Dᵀ A D of a function of those relative positions, with A a random symmetric
+/// matrix: translation-invariant, and indefinite for most A.
+Eigen::Matrix<double, 12, 12> translation_invariant_hessian(const std::vector<int>& points,
+                                                            unsigned seed) {
+  std::srand(seed);
+  const Eigen::MatrixXd differences = relative_positions(points);
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(differences.rows(), differences.rows());
   return differences.transpose() * (a + a.transpose()) * differences;
 }
 
@@ -64,12 +70,7 @@ TEST(PsdProjection, TranslationInvariantBlocksProjectLikeTheFullEigensolver) {
 
 TEST(PsdProjection, TranslationInvariantPositiveSemiDefiniteBlocksStayUnchanged) {
   const Eigen::MatrixXd a = Eigen::MatrixXd::Random(9, 9);
-  Eigen::MatrixXd differences = Eigen::MatrixXd::Zero(9, 12);
-  for (int k = 1; k < 4; ++k)
-    for (int axis = 0; axis < 3; ++axis) {
-      differences(3 * (k - 1) + axis, 3 * k + axis) = 1;
-      differences(3 * (k - 1) + axis, axis) = -1;
-    }
+  const Eigen::MatrixXd differences = relative_positions({0, 1, 2, 3});
   Eigen::Matrix<double, 12, 12> m = differences.transpose() * a * a.transpose() * differences;
   const Eigen::Matrix<double, 12, 12> before = m;
   project_translation_invariant_to_psd(m);

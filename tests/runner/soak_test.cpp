@@ -57,8 +57,8 @@ int positive_from_environment(const char* name, int fallback) {
 int kill_count() { return positive_from_environment("PSQ_SOAK_KILLS", 15); }
 unsigned seed() { return static_cast<unsigned>(positive_from_environment("PSQ_SOAK_SEED", 1)); }
 
-/// A workspace with the soak sweep: the cantilever over 40 frames (four times the scene's, so that a
-/// job lasts through a few signals) at depths 1 and 2, `thicknesses` thicknesses.
+/// A workspace with the soak sweep: the cantilever over 40 frames (four times the scene's, so
+/// that a job lasts through a few signals) at depths 1 and 2, `thicknesses` thicknesses.
 struct SoakSweep : test::CantileverWorkspace {
   SoakSweep(const std::string& name, int thicknesses) : CantileverWorkspace(name) {
     std::string values;
