@@ -13,6 +13,7 @@ std::map<std::string, double> named_refinement_statistics(
                   {"batches", s->batches},
                   {"perturbation_retries", s->perturbation_retries},
                   {"ccd_rounds", s->ccd_rounds},
+                  {"folded_advances", s->folded_advances},
                   {"relaxed_vertices", s->relaxed_vertices},
                   {"relax_iterations", s->relax_iterations},
                   {"smallest_gap", s->smallest_gap},

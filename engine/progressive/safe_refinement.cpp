@@ -218,20 +218,16 @@ std::vector<int> close_vertices(const MixedMesh& mesh, const BroadPhase& broad, 
   return vertices;
 }
 
-/// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
-/// displacements `delta` (rows per fine vertex; zero rows stay): rounds of ACCD over the swept
-/// candidates, each moving all by the smallest safe fraction and then stopping the vertices of
-/// the limiting pairs. y is updated; returns the rounds taken.
-int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const AdditiveCcdSettings& ccd,
-            double gap, Positions& y, Positions delta) {
-  const BroadPhase broad = mesh.broad_phase(may_touch);
-  Positions p = mesh.positions(y);
-  Positions d = mesh.positions(delta);
-  // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion. Each
-  // round's motion lies within the first one's (a vertex goes on along its segment, or stops
-  // on it), so the first round's candidates serve them all.
-  const std::vector<ContactPair> pairs =
-      candidate_pairs(broad.swept_candidates(p, p + d, ccd.min_distance + gap), broad);
+/// The rounds of an additive CCD advance (§4.4.4) of mixed positions p by d over the candidate
+/// `pairs`: each round moves all by the smallest safe fraction and then stops the vertices of the
+/// limiting pairs. With `check_folds`, each round is also checked exactly: the CCD sees no pair of
+/// neighbouring triangles, and the motion, blind to physics, may fold two of them through each
+/// other across their shared edge; the step is then halved, and the vertices of a fold that
+/// remains are stopped. Returns the rounds taken.
+int advance_rounds(const MixedMesh& mesh, const BodyPairRule& may_touch,
+                   const AdditiveCcdSettings& ccd, double gap,
+                   const std::vector<ContactPair>& pairs, bool check_folds, Positions& p,
+                   Positions d) {
   int rounds = 0;
   for (; rounds < kMaxAdvanceRounds && !d.isZero(0.0); ++rounds) {
     const Positions end = p + d;
@@ -255,11 +251,8 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
       if (result.collision) toi[i] = result.toi;
     });
     double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
-    // The CCD sees no pair of neighbouring triangles: the motion, blind to physics, may fold two
-    // of them through each other across their shared edge. The exact check catches that; the
-    // step is halved, and the vertices of a fold that remains are stopped.
     std::vector<int> folded;
-    for (int halvings = 0; alpha > 0.0; ++halvings) {
+    for (int halvings = 0; check_folds && alpha > 0.0; ++halvings) {
       folded = intersecting_vertices(mesh, p + alpha * d, may_touch, false);
       if (folded.empty()) break;
       if (halvings == kMaxFoldHalvings) {
@@ -277,9 +270,33 @@ int advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const Additive
       for (int k : pairs[i].vertices) d.row(k).setZero();
     }
   }
+  return rounds;
+}
+
+/// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
+/// displacements `delta` (rows per fine vertex; zero rows stay). y is updated, and the rounds and
+/// any redone advance are counted in `stats`. Folds are rare, and the exact check of the whole mesh costs a round more than its CCD,
+/// so the rounds run unchecked and the end state is checked once; only an advance that ends folded is redone with every round
+/// checked.
+void advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const AdditiveCcdSettings& ccd,
+             double gap, Positions& y, const Positions& delta, RefinementStats& stats) {
+  const BroadPhase broad = mesh.broad_phase(may_touch);
+  const Positions start = mesh.positions(y);
+  const Positions d = mesh.positions(delta);
+  // Reach g: a pair the broad phase culls then stays farther than g, whatever its motion. Each
+  // round's motion lies within the first one's (a vertex goes on along its segment, or stops
+  // on it), so the first round's candidates serve them all.
+  const std::vector<ContactPair> pairs =
+      candidate_pairs(broad.swept_candidates(start, start + d, ccd.min_distance + gap), broad);
+  Positions p = start;
+  stats.ccd_rounds += advance_rounds(mesh, may_touch, ccd, gap, pairs, false, p, d);
+  if (!intersecting_vertices(mesh, p, may_touch, false).empty()) {
+    ++stats.folded_advances;
+    p = start;
+    stats.ccd_rounds += advance_rounds(mesh, may_touch, ccd, gap, pairs, true, p, d);
+  }
   for (std::size_t m = 0; m < mesh.fine_vertex.size(); ++m)
     y.row(mesh.fine_vertex[m]) = p.row(static_cast<Eigen::Index>(m));
-  return rounds;
 }
 
 /// The smallest distance between primitives of the mixed mesh at y that may touch, capped at
@@ -692,11 +709,11 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
                  layouts[k].layout);
       for (int v : children[k]) growth.row(v) = full.row(v) - y.row(v);
     }
-    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(growth));
+    advance(mixed, surface.may_touch, ccd, safe_gap, y, growth, stats);
     Positions delta = Positions::Zero(n, 3);
     for (int k : clusters)
       for (int v : children[k]) delta.row(v) = goal.row(v) - y.row(v);
-    stats.ccd_rounds += advance(mixed, surface.may_touch, ccd, safe_gap, y, std::move(delta));
+    advance(mixed, surface.may_touch, ccd, safe_gap, y, delta, stats);
     stats.ccd_seconds += since(phase);
 
     std::vector<bool> movable(n, false);
@@ -710,7 +727,7 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   if (!std::isfinite(stats.smallest_gap)) stats.smallest_gap = safe_gap;
   tell("advance");
   phase = Clock::now();
-  stats.ccd_rounds += advance(full, surface.may_touch, ccd, safe_gap, y, goal - y);
+  advance(full, surface.may_touch, ccd, safe_gap, y, goal - y, stats);
   stats.ccd_seconds += since(phase);
 
   // Vertices the advances stopped short, and pairs left closer than g, are relaxed (§4.4.3).

@@ -62,6 +62,7 @@ struct RefinementStats {
   int batches = 0;                ///< colours with at least one expansion
   int perturbation_retries = 0;   ///< cluster perturbations tried again after an intersection
   int ccd_rounds = 0;             ///< additive CCD advances, all batches and the final one
+  int folded_advances = 0;        ///< advances that ended folded, redone with each round checked
   double smallest_gap = 0.0;      ///< smallest g measured before a batch [m]
   double final_gap = 0.0;         ///< smallest distance at the initializer (capped at d̂) [m]
   double max_target_distance = 0.0;   ///< largest |initializer − prolonged target| of a vertex

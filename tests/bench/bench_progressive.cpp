@@ -164,9 +164,9 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
       const psq::RefinementStats& r = sim.refinements().back();
       std::cout << fmt::format(
           " [safe initialization {:.2f} s: gap {:.2f}, perturbation {:.2f}, CCD advance {:.2f} "
-          "({} rounds), relaxation {:.2f}, exact check {:.2f} s; {} batches]",
-          r.seconds, r.gap_seconds, r.perturb_seconds, r.ccd_seconds, r.ccd_rounds, r.relax_seconds,
-          r.check_seconds, r.batches);
+          "({} rounds, {} redone for a fold), relaxation {:.2f}, exact check {:.2f} s; {} batches]",
+          r.seconds, r.gap_seconds, r.perturb_seconds, r.ccd_seconds, r.ccd_rounds,
+          r.folded_advances, r.relax_seconds, r.check_seconds, r.batches);
     }
     std::cout << "\n";
   }
