@@ -323,21 +323,19 @@ RelaxationStats relax_batch(const MixedMesh& mesh, const ContactSurface& surface
   mixed_surface.vertex_body = mesh.body;
   mixed_surface.may_touch = surface.may_touch;
   mixed_surface.rest = mesh.positions(surface.rest);
-  ContactTerm contact(std::move(mixed_surface), parameters, std::nullopt, bbox_diagonal, 1.0);
-  Eigen::VectorXd x = flat(mesh.positions(y));
+  Positions p = mesh.positions(y);
+  const Eigen::VectorXd x = flat(p);
   const int m = static_cast<int>(mesh.fine_vertex.size());
   std::vector<bool> freed(m, false);
-  for (const ContactPair& pair : contact.potential().active_pairs(x))
+  ContactPotential whole(mixed_surface, parameters);
+  for (const ContactPair& pair : whole.active_pairs(x))
     if (std::sqrt(pair_distance(pair, x)) < gap)
       for (int k : pair.vertices)
         if (k >= 0 && movable[mesh.fine_vertex[k]]) freed[k] = true;
-  std::vector<int> held;
-  for (int k = 0; k < m; ++k)
-    if (!freed[k]) held.push_back(k);
-  const DofMap dofs(m, held);
   RelaxationStats stats;
   try {
-    stats = relax_free_vertices(contact, flat(mesh.positions(goal)), dofs, gap, x);
+    stats = relax_on_patch(mixed_surface, parameters, std::nullopt, bbox_diagonal, freed,
+                           mesh.positions(goal), gap, p);
   } catch (const NumericalError&) {
     // A pair left nearly coincident by a vertex-by-vertex split gives the CCD no step: the
     // batch stays as its advance left it, intersection-free, and the later advances and the
@@ -345,7 +343,6 @@ RelaxationStats relax_batch(const MixedMesh& mesh, const ContactSurface& surface
     return stats;
   }
   if (stats.vertices == 0) return stats;
-  const Positions p = as_positions(x);
   if (!intersecting_vertices(mesh, p, surface.may_touch, false).empty()) {
     stats.vertices = 0;  // its work is counted, but no vertex was relaxed
     return stats;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "engine/contact/contact_potential.hpp"
 #include "engine/progressive/local_solve.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/newton.hpp"
@@ -43,8 +44,9 @@ double closest_free_pair(ContactTerm& contact, const DofMap& dofs, const Eigen::
 
 }  // namespace
 
-TargetPull::TargetPull(Eigen::VectorXd target, ContactTerm& contact)
-    : target_(std::move(target)), contact_(contact) {}
+TargetPull::TargetPull(Eigen::VectorXd target, ContactTerm& contact,
+                       const Confinement& confinement)
+    : target_(std::move(target)), contact_(contact), confinement_(confinement) {}
 
 double TargetPull::value(const Eigen::VectorXd& x) {
   return 0.5 * (x - target_).squaredNorm() + contact_.value(x);
@@ -62,33 +64,69 @@ void TargetPull::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
 }
 
 double TargetPull::max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {
-  return contact_.max_feasible_step(x, dx);
+  return std::min(confinement_.max_step(x, dx), contact_.max_feasible_step(x, dx));
 }
 
 RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::VectorXd& target,
                                      double safe_gap, Eigen::VectorXd& x) {
-  ContactTerm contact(fine);
-  const double reach = contact.potential().parameters().band.activation_distance;
+  const ContactSurface surface = contact_surface(fine, fine.scene().contact.self_contact);
+  const ContactParameters parameters = contact_parameters(fine);
+  const double reach = parameters.band.activation_distance;
   const Eigen::Index n = x.size() / 3;
   std::vector<bool> freed(n, false);
   if (strain_limit_enabled(fine.scene()))
     for (Eigen::Index v = 0; v < n; ++v)
       freed[v] = (x.segment<3>(3 * v) - target.segment<3>(3 * v)).norm() > reach;
-  for (const ContactPair& pair : contact.potential().active_pairs(x))
+  ContactPotential whole(surface, parameters);
+  for (const ContactPair& pair : whole.active_pairs(x))
     if (std::sqrt(pair_distance(pair, x)) < safe_gap)
-      for (int v : pair.vertices) freed[v] = true;
-  return relax_free_vertices(contact, target, movable_vertex_dofs(fine, freed), safe_gap, x);
+      for (int v : pair.vertices)
+        if (v >= 0) freed[v] = true;
+  for (const PinnedVertex& pin : fine.pinned()) freed[pin.vertex] = false;
+  Positions p = as_positions(x);
+  const RelaxationStats stats =
+      relax_on_patch(surface, parameters, fine.scene().contact.stiffness,
+                     bounding_box_diagonal(fine.rest_mesh().vertices), freed,
+                     as_positions(target), safe_gap, p);
+  x = flat(p);
+  return stats;
+}
+
+RelaxationStats relax_on_patch(const ContactSurface& surface, const ContactParameters& parameters,
+                               std::optional<double> fixed_stiffness, double bbox_diagonal,
+                               const std::vector<bool>& freed, const Positions& target,
+                               double safe_gap, Positions& x) {
+  if (std::none_of(freed.begin(), freed.end(), [](bool f) { return f; })) return {};
+  RelaxationPatch patch = relaxation_patch(
+      surface, x, target, freed, parameters.band.thickness + parameters.band.activation_distance);
+  const auto m = static_cast<Eigen::Index>(patch.vertex.size());
+  Positions patch_x(m, 3), patch_target(m, 3);
+  std::vector<int> held;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    patch_x.row(k) = x.row(patch.vertex[k]);
+    patch_target.row(k) = target.row(patch.vertex[k]);
+    if (!patch.freed[k]) held.push_back(static_cast<int>(k));
+  }
+  // The mass enters κ's balance only as m̄ times its 1/m̄ (balance_barrier_stiffness).
+  ContactTerm contact(std::move(patch.surface), parameters, fixed_stiffness, bbox_diagonal, 1.0);
+  Eigen::VectorXd relaxed = flat(patch_x);
+  const RelaxationStats stats = relax_free_vertices(contact, flat(patch_target), DofMap(m, held),
+                                                    safe_gap, relaxed, patch.confinement);
+  for (Eigen::Index k = 0; k < m; ++k)
+    if (patch.freed[k]) x.row(patch.vertex[k]) = relaxed.segment<3>(3 * k).transpose();
+  return stats;
 }
 
 RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
-                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x) {
+                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x,
+                                    const Confinement& confinement) {
   const auto started = std::chrono::steady_clock::now();
   RelaxationStats stats;
   stats.vertices = static_cast<int>(dofs.free_size() / 3);
   if (stats.vertices == 0) return stats;
   balance_barrier_stiffness(contact, x, x - target, dofs);
 
-  TargetPull pull(target, contact);
+  TargetPull pull(target, contact, confinement);
   NewtonSolver newton;
   NewtonSettings settings;
   settings.max_iterations = kIterationsPerUpdate;

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "engine/progressive/relaxation_patch.hpp"
 #include "engine/sim/contact_term.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "engine/solver/dof_map.hpp"
@@ -33,8 +34,8 @@ namespace psq {
 /// R above over a system's vertices.
 class TargetPull final : public Objective {
  public:
-  /// `contact` must outlive this objective.
-  TargetPull(Eigen::VectorXd target, ContactTerm& contact);
+  /// `contact` and `confinement` (whose boxes cut every step) must outlive this objective.
+  TargetPull(Eigen::VectorXd target, ContactTerm& contact, const Confinement& confinement);
 
   [[nodiscard]] Eigen::Index size() const override { return target_.size(); }
   double value(const Eigen::VectorXd& x) override;
@@ -46,6 +47,7 @@ class TargetPull final : public Objective {
  private:
   Eigen::VectorXd target_;
   ContactTerm& contact_;
+  const Confinement& confinement_;
 };
 
 /// What one relaxation did.
@@ -60,11 +62,21 @@ struct RelaxationStats {
 RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::VectorXd& target,
                                      double safe_gap, Eigen::VectorXd& x);
 
+/// Relaxes the vertices `freed` of any contact surface at x (intersection-free) toward `target`
+/// by relax_free_vertices on their patch (relaxation_patch.hpp), the others held; κ as in
+/// ContactTerm's constructor.
+RelaxationStats relax_on_patch(const ContactSurface& surface, const ContactParameters& parameters,
+                               std::optional<double> fixed_stiffness, double bbox_diagonal,
+                               const std::vector<bool>& freed, const Positions& target,
+                               double safe_gap, Positions& x);
+
 /// Minimizes R over the DOFs `dofs` frees, from x (intersection-free), with κ balanced against
 /// the pull at x and IPC's updates, then raised tenfold per round while a pair with a freed
 /// vertex stays closer than g/2 (at most three times): the relaxation of relax_toward_targets on
 /// any contact surface, such as a partly expanded level's between two batches (paper §4.4.4).
+/// Steps are cut to keep the vertices inside `confinement`'s boxes.
 RelaxationStats relax_free_vertices(ContactTerm& contact, const Eigen::VectorXd& target,
-                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x);
+                                    const DofMap& dofs, double safe_gap, Eigen::VectorXd& x,
+                                    const Confinement& confinement = {});
 
 }  // namespace psq
