@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -230,10 +231,23 @@ ContactPotential::ContactPotential(ContactSurface surface, const ContactParamete
       broad_phase_(surface_.triangles, surface_.edges, surface_.vertex_body, surface_.may_touch) {
   parameters_.ccd.min_distance = parameters_.band.thickness;
   check_parameters(parameters_);
+  if (!surface_.held.empty() && surface_.held.size() != surface_.vertex_body.size())
+    throw std::invalid_argument(fmt::format("contact surface: {} held flags for {} vertices",
+                                            surface_.held.size(), surface_.vertex_body.size()));
 }
 
 double ContactPotential::reach() const {
   return parameters_.band.thickness + parameters_.band.activation_distance;
+}
+
+std::vector<ContactPair> ContactPotential::moving_pairs(const ContactCandidates& candidates) const {
+  std::vector<ContactPair> pairs = candidate_pairs(candidates, broad_phase_);
+  if (surface_.held.empty()) return pairs;
+  std::erase_if(pairs, [&](const ContactPair& pair) {
+    return std::all_of(pair.vertices.begin(), pair.vertices.end(),
+                       [&](int v) { return surface_.held[v]; });
+  });
+  return pairs;
 }
 
 void ContactPotential::refresh(const Eigen::VectorXd& x) {
@@ -269,7 +283,7 @@ void ContactPotential::refresh(const Eigen::VectorXd& x) {
     }
   }
   ScopedTimer timer(stats_.barrier_seconds);
-  std::vector<ContactPair> pairs = candidate_pairs(*candidates, broad_phase_);
+  std::vector<ContactPair> pairs = moving_pairs(*candidates);
   std::vector<double> distance(pairs.size());
   // The kept region's candidates reach farther than the state needs (its skin): the boxes
   // sort out most of those before the exact distance.
@@ -417,7 +431,7 @@ double ContactPotential::max_feasible_step(const Eigen::VectorXd& x, const Eigen
   }
   const ContactCandidates& candidates = swept_candidates(start, end);
   stats_.ccd_pair_queries += static_cast<long>(candidates.size());
-  return smallest_time_of_impact(candidate_pairs(candidates, broad_phase_), x, x + dx,
+  return smallest_time_of_impact(moving_pairs(candidates), x, x + dx,
                                  parameters_.ccd);
 }
 

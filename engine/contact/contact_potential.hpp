@@ -44,6 +44,9 @@ struct ContactSurface {
   std::vector<int> vertex_body;           ///< body id of every vertex, 0..B−1
   BodyPairRule may_touch;                 ///< which bodies touch (self-contact: a == b)
   Positions rest;                         ///< rest positions (edge–edge mollifier thresholds)
+  /// Per vertex, whether the solve holds it (empty: none is held). A pair of held vertices
+  /// only has a constant barrier: it is left out of the potential, its derivatives and the CCD.
+  std::vector<bool> held;
 };
 
 struct ContactParameters {
@@ -165,6 +168,8 @@ class ContactPotential {
   /// (its boxes are convex, so the whole motion), else a new search that becomes the region.
   const ContactCandidates& swept_candidates(const Positions& start, const Positions& end);
 
+  /// The candidates' pairs, without those of held vertices only.
+  [[nodiscard]] std::vector<ContactPair> moving_pairs(const ContactCandidates& candidates) const;
   void refresh(const Eigen::VectorXd& x);
   bool renew_certificate(const Eigen::VectorXd& x);
   void accumulate_gradient(const Eigen::VectorXd& x, double scale, Eigen::VectorXd& g);

@@ -113,6 +113,7 @@ RelaxationPatch relaxation_patch(const ContactSurface& surface, const Positions&
     patch.surface.rest.row(k) = surface.rest.row(v);
     patch.surface.vertex_body.push_back(surface.vertex_body[v]);
     patch.freed.push_back(freed[v]);
+    patch.surface.held.push_back(!freed[v]);
     patch.confinement.box_of.push_back(cluster[v]);
   }
   const auto triangle_count = static_cast<std::size_t>(surface.triangles.rows());

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -160,6 +161,41 @@ TEST(ContactPotential, SkipsTheBarrierWhenNothingIsWithinReach) {
   ContactPotential contact(near.surface, parameters());
   EXPECT_GT(contact.value(near.x), 0.0);
   EXPECT_EQ(contact.stats().barrier_skips, 0);
+}
+
+// With the lower sheet and half the upper one held, the potential keeps exactly the pairs with
+// a moving vertex, and its gradient on the moving vertices is the whole potential's.
+TEST(ContactPotential, LeavesOutThePairsOfHeldVerticesOnly) {
+  TwoSheets sheets = sheets_in_contact();
+  const int n = static_cast<int>(sheets.x.size() / 3);
+  ContactSurface held_surface = sheets.surface;
+  held_surface.held.assign(n, true);
+  for (int v = sheets.lower_vertices; v < n; v += 2) held_surface.held[v] = false;
+  ContactPotential whole(sheets.surface, parameters());
+  ContactPotential partly_held(held_surface, parameters());
+
+  const auto moves = [&](const ContactPair& pair) {
+    return std::any_of(pair.vertices.begin(), pair.vertices.end(),
+                       [&](int v) { return !held_surface.held[v]; });
+  };
+  const std::vector<ContactPair>& all = whole.active_pairs(sheets.x);
+  const auto expected = std::count_if(all.begin(), all.end(), moves);
+  ASSERT_GT(expected, 0);
+  ASSERT_LT(expected, static_cast<long>(all.size()));  // some pairs are of held vertices only
+  const std::vector<ContactPair>& kept = partly_held.active_pairs(sheets.x);
+  EXPECT_EQ(static_cast<long>(kept.size()), expected);
+  EXPECT_TRUE(std::all_of(kept.begin(), kept.end(), moves));
+
+  Eigen::VectorXd g_whole = Eigen::VectorXd::Zero(sheets.x.size());
+  Eigen::VectorXd g_held = g_whole;
+  whole.add_gradient(sheets.x, g_whole);
+  partly_held.add_gradient(sheets.x, g_held);
+  for (int v = 0; v < n; ++v) {
+    if (held_surface.held[v]) continue;
+    EXPECT_LE((g_held.segment<3>(3 * v) - g_whole.segment<3>(3 * v)).norm(),
+              1e-12 * g_whole.segment<3>(3 * v).norm() + 1e-300)
+        << "vertex " << v;
+  }
 }
 
 TEST(ContactPotential, FeasibleStepStopsAHeadOnApproachBeforeContact) {
