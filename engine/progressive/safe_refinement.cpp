@@ -220,14 +220,19 @@ std::vector<int> close_vertices(const MixedMesh& mesh, const BroadPhase& broad, 
 
 /// The rounds of an additive CCD advance (§4.4.4) of mixed positions p by d over the candidate
 /// `pairs`: each round moves all by the smallest safe fraction and then stops the vertices of the
-/// limiting pairs. With `check_folds`, each round is also checked exactly: the CCD sees no pair of
-/// neighbouring triangles, and the motion, blind to physics, may fold two of them through each
-/// other across their shared edge; the step is then halved, and the vertices of a fold that
-/// remains are stopped. Returns the rounds taken.
+/// limiting pairs. A pair that its last query found free over its whole motion, none of whose
+/// vertices stopped since, goes on along the rest of that motion: it is not asked again while
+/// its gap bound (ratio bound times gap) has not grown. With `check_folds`, each round is also
+/// checked exactly: the CCD sees no pair of neighbouring triangles, and the motion, blind to
+/// physics, may fold two of them through each other across their shared edge; the step is then
+/// halved, and the vertices of a fold that remains are stopped. Returns the rounds taken.
 int advance_rounds(const MixedMesh& mesh, const BodyPairRule& may_touch,
                    const AdditiveCcdSettings& ccd, double gap,
                    const std::vector<ContactPair>& pairs, bool check_folds, Positions& p,
                    Positions d) {
+  // Per pair, the gap bound its last query certified the whole motion with (−1: none).
+  std::vector<double> certified(pairs.size(), -1.0);
+  std::vector<char> stopped(static_cast<std::size_t>(p.rows()), 0);
   int rounds = 0;
   for (; rounds < kMaxAdvanceRounds && !d.isZero(0.0); ++rounds) {
     const Positions end = p + d;
@@ -241,14 +246,21 @@ int advance_rounds(const MixedMesh& mesh, const BodyPairRule& may_touch,
     tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t i) {
       const ContactPair& pair = pairs[i];
       if (!moving(pair.vertices)) return;
+      const double gap0 = std::sqrt(pair_distance(pair, x0)) - ccd.min_distance;
+      AdditiveCcdSettings settings = ccd;
+      settings.ratio_bound = gap0 < gap ? kCloseRatioBound : kFarRatioBound;
+      const double bound = settings.ratio_bound * gap0;
+      if (certified[i] >= 0.0 && bound <= certified[i]) return;
       const PairPositions start = stencil_positions(pair.vertices, x0);
       const PairPositions stop = stencil_positions(pair.vertices, x1);
-      const double d0 = std::sqrt(pair_distance(pair, x0));
-      AdditiveCcdSettings settings = ccd;
-      settings.ratio_bound = d0 - ccd.min_distance < gap ? kCloseRatioBound : kFarRatioBound;
       const CcdResult result = pair.edge_edge ? edge_edge_ccd(start, stop, settings)
                                               : point_triangle_ccd(start, stop, settings);
-      if (result.collision) toi[i] = result.toi;
+      if (result.collision) {
+        toi[i] = result.toi;
+        certified[i] = -1.0;
+      } else {
+        certified[i] = bound;
+      }
     });
     double alpha = toi.empty() ? 1.0 : *std::min_element(toi.begin(), toi.end());
     std::vector<int> folded;
@@ -263,11 +275,17 @@ int advance_rounds(const MixedMesh& mesh, const BodyPairRule& may_touch,
     }
     p += alpha * d;
     if (alpha >= 1.0) break;
-    for (int m : folded) d.row(m).setZero();
+    std::fill(stopped.begin(), stopped.end(), 0);
+    for (int m : folded) stopped[m] = 1;
+    for (std::size_t i = 0; i < toi.size(); ++i)
+      if (toi[i] <= alpha)
+        for (int k : pairs[i].vertices) stopped[k] = 1;
     d *= 1.0 - alpha;
-    for (std::size_t i = 0; i < toi.size(); ++i) {
-      if (toi[i] > alpha) continue;
-      for (int k : pairs[i].vertices) d.row(k).setZero();
+    for (std::size_t m = 0; m < stopped.size(); ++m)
+      if (stopped[m]) d.row(static_cast<Eigen::Index>(m)).setZero();
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const auto& v = pairs[i].vertices;
+      if (stopped[v[0]] || stopped[v[1]] || stopped[v[2]] || stopped[v[3]]) certified[i] = -1.0;
     }
   }
   return rounds;
@@ -275,9 +293,9 @@ int advance_rounds(const MixedMesh& mesh, const BodyPairRule& may_touch,
 
 /// One batch's additive CCD advance (§4.4.4) of the mixed mesh's vertices at y by the
 /// displacements `delta` (rows per fine vertex; zero rows stay). y is updated, and the rounds and
-/// any redone advance are counted in `stats`. Folds are rare, and the exact check of the whole mesh costs a round more than its CCD,
-/// so the rounds run unchecked and the end state is checked once; only an advance that ends folded is redone with every round
-/// checked.
+/// any redone advance are counted in `stats`. Folds are rare, and the exact check of the whole
+/// mesh costs a round more than its CCD, so the rounds run unchecked and the end state is
+/// checked once; only an advance that ends folded is redone with every round checked.
 void advance(const MixedMesh& mesh, const BodyPairRule& may_touch, const AdditiveCcdSettings& ccd,
              double gap, Positions& y, const Positions& delta, RefinementStats& stats) {
   const BroadPhase broad = mesh.broad_phase(may_touch);
