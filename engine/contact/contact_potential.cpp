@@ -396,7 +396,10 @@ Eigen::VectorXd ContactPotential::unit_gradient(const Eigen::VectorXd& x) {
 }
 
 void ContactPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& blocks,
-                               bool project_psd) {
+                               bool project_psd, const std::vector<bool>& fixed_vertices) {
+  if (!fixed_vertices.empty() && fixed_vertices.size() != surface_.vertex_body.size())
+    throw std::invalid_argument(fmt::format("contact Hessian: {} fixed flags for {} vertices",
+                                            fixed_vertices.size(), surface_.vertex_body.size()));
   refresh(x);
   std::vector<int> stencils;
   stencils.reserve(4 * active_.size());
@@ -406,7 +409,12 @@ void ContactPotential::hessian(const Eigen::VectorXd& x, ElementMatrices& blocks
   ScopedTimer timer(stats_.barrier_seconds);
   tbb::parallel_for(std::size_t{0}, active_.size(), [&](std::size_t k) {
     Eigen::Matrix<double, 12, 12> h = pair_derivatives(active_[k], x, parameters_.band).hessian;
-    if (project_psd) project_translation_invariant_to_psd(h);
+    if (project_psd) {
+      std::array<bool, 4> fixed{};
+      if (!fixed_vertices.empty())
+        for (int i = 0; i < 4; ++i) fixed[i] = fixed_vertices[active_[k].vertices[i]];
+      project_moving_block_to_psd(h, fixed);
+    }
     blocks.block(k) = stiffness_ * h;
   });
 }

@@ -128,9 +128,11 @@ class ContactPotential {
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g);
   /// ∇ of Σ b (κ = 1), for the initial stiffness.
   Eigen::VectorXd unit_gradient(const Eigen::VectorXd& x);
-  /// Resets `blocks` to one 4-vertex block per pair within reach: κ·PSD(∇²(m b)), or κ ∇²(m b)
-  /// itself without `project_psd` (for derivative checks).
-  void hessian(const Eigen::VectorXd& x, ElementMatrices& blocks, bool project_psd = true);
+  /// Resets `blocks` to one 4-vertex block per pair within reach: κ·PSD(∇²(m b)) over the
+  /// vertices not in `fixed_vertices` (project_moving_block_to_psd; empty: none is fixed), or
+  /// κ ∇²(m b) itself without `project_psd` (for derivative checks).
+  void hessian(const Eigen::VectorXd& x, ElementMatrices& blocks, bool project_psd = true,
+               const std::vector<bool>& fixed_vertices = {});
   /// The smallest squared distance of a pair within reach at x, +∞ when there is none.
   double min_distance(const Eigen::VectorXd& x);
   /// The pairs within reach at x (cached while x does not change).

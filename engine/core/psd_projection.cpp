@@ -46,6 +46,21 @@ void project_relative_block(Eigen::Matrix<double, 12, 12>& hessian,
   if (clamp_negative_eigenvalues(relative)) hessian = basis * relative * basis.transpose();
 }
 
+/// Projects the block of `hessian` over the `Size / 3` given points, zeroing every other entry.
+template <int Size>
+void project_point_block(Eigen::Matrix<double, 12, 12>& hessian, const std::array<int, 4>& points) {
+  constexpr int kPoints = Size / 3;
+  Eigen::Matrix<double, Size, Size> block;
+  for (int a = 0; a < kPoints; ++a)
+    for (int b = 0; b < kPoints; ++b)
+      block.template block<3, 3>(3 * a, 3 * b) = hessian.block<3, 3>(3 * points[a], 3 * points[b]);
+  clamp_negative_eigenvalues(block);
+  hessian.setZero();
+  for (int a = 0; a < kPoints; ++a)
+    for (int b = 0; b < kPoints; ++b)
+      hessian.block<3, 3>(3 * points[a], 3 * points[b]) = block.template block<3, 3>(3 * a, 3 * b);
+}
+
 }  // namespace
 
 void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric) {
@@ -66,6 +81,31 @@ void project_translation_invariant_to_psd(Eigen::Matrix<double, 12, 12>& hessian
     case 2: project_relative_block<3>(hessian, points); break;
     case 3: project_relative_block<6>(hessian, points); break;
     default: project_relative_block<9>(hessian, points); break;
+  }
+}
+
+void project_moving_block_to_psd(Eigen::Matrix<double, 12, 12>& hessian,
+                                 const std::array<bool, 4>& fixed) {
+  std::array<int, 4> moving{};
+  int count = 0;
+  bool holds_one = false;
+  for (int p = 0; p < 4; ++p) {
+    // A point the pair does not depend on (its rows are zero) needs no row in the projection.
+    if (hessian.middleRows<3>(3 * p).isZero(0.0)) continue;
+    if (fixed[p])
+      holds_one = true;
+    else
+      moving[count++] = p;
+  }
+  if (!holds_one) {
+    project_translation_invariant_to_psd(hessian);
+    return;
+  }
+  switch (count) {
+    case 0: hessian.setZero(); break;
+    case 1: project_point_block<3>(hessian, moving); break;
+    case 2: project_point_block<6>(hessian, moving); break;
+    default: project_point_block<9>(hessian, moving); break;
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <Eigen/Core>
+#include <array>
 
 namespace psq {
 
@@ -16,5 +17,14 @@ void project_to_psd(Eigen::Ref<Eigen::MatrixXd> symmetric);
 /// gives the full projection up to rounding, with an eigensolver of at most 9×9 instead of
 /// 12×12 (its speed-up: docs/benchmarks.md).
 void project_translation_invariant_to_psd(Eigen::Matrix<double, 12, 12>& hessian);
+
+/// Such a 12×12 Hessian as a solve that holds the `fixed` points sees it: their rows and
+/// columns zeroed and the block of the points that move projected. The system never holds the
+/// fixed rows, so projecting the whole block would clamp curvature against motions the solve
+/// cannot make, and would cost a 9×9 eigensolver where a point against a triangle of a fixed
+/// collider needs a 3×3 one. The moving block is not translation invariant once a point is
+/// fixed, so it is projected as it is. With no point fixed: project_translation_invariant_to_psd.
+void project_moving_block_to_psd(Eigen::Matrix<double, 12, 12>& hessian,
+                                 const std::array<bool, 4>& fixed);
 
 }  // namespace psq

@@ -150,9 +150,9 @@ void ContactTerm::load_state(const std::map<std::string, double>& state) {
   potential_.set_stiffness(stiffness_.value);
 }
 
-void ContactTerm::hessian(const Eigen::VectorXd& x, Eigen::VectorXd& /*diagonal*/,
-                          ElementMatrices& blocks) {
-  potential_.hessian(x, blocks);
+void ContactTerm::hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
+                          Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
+  potential_.hessian(x, blocks, true, fixed_vertices);
 }
 
 }  // namespace psq

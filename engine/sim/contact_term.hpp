@@ -67,8 +67,8 @@ class ContactTerm : public PotentialTerm {
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
     potential_.add_gradient(x, g);
   }
-  void hessian(const Eigen::VectorXd& x, Eigen::VectorXd& diagonal,
-               ElementMatrices& blocks) override;
+  void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
+               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) override {
     return potential_.max_feasible_step(x, dx);
   }

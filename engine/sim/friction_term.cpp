@@ -96,8 +96,8 @@ void FrictionTerm::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
   potential_.add_gradient(x, g);
 }
 
-void FrictionTerm::hessian(const Eigen::VectorXd& x, Eigen::VectorXd& /*diagonal*/,
-                           ElementMatrices& blocks) {
+void FrictionTerm::hessian(const Eigen::VectorXd& x, const std::vector<bool>& /*fixed_vertices*/,
+                           Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
   const ScopedTimer timer(seconds_);
   potential_.hessian(x, blocks);
 }

@@ -65,7 +65,7 @@ void IncrementalPotential::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
   }
   H.batches.resize(elastic_batches + terms_.size());
   for (std::size_t t = 0; t < terms_.size(); ++t)
-    terms_[t]->hessian(x, H.diagonal, H.batches[elastic_batches + t]);
+    terms_[t]->hessian(x, H.fixed_vertices, H.diagonal, H.batches[elastic_batches + t]);
 }
 
 double IncrementalPotential::max_feasible_step(const Eigen::VectorXd& x,

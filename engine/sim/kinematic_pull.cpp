@@ -35,7 +35,8 @@ void KinematicPull::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
   }
 }
 
-void KinematicPull::hessian(const Eigen::VectorXd& /*x*/, Eigen::VectorXd& diagonal,
+void KinematicPull::hessian(const Eigen::VectorXd& /*x*/,
+                            const std::vector<bool>& /*fixed_vertices*/, Eigen::VectorXd& diagonal,
                             ElementMatrices& blocks) {
   blocks.reset(0, {});
   for (std::size_t i = 0; i < vertices_.size(); ++i)

@@ -31,8 +31,8 @@ class KinematicPull : public PotentialTerm {
   double value(const Eigen::VectorXd& x) override;
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
   /// Diagonal only: k wᵢ on the three DOFs of each pulled vertex.
-  void hessian(const Eigen::VectorXd& x, Eigen::VectorXd& diagonal,
-               ElementMatrices& blocks) override;
+  void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
+               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
 
  private:
   std::vector<int> vertices_;

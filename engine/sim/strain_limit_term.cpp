@@ -103,8 +103,9 @@ void StrainLimitTerm::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g)
   for (const StrainLimitEnergy& energy : energies_) energy.add_gradient(x, g);
 }
 
-void StrainLimitTerm::hessian(const Eigen::VectorXd& x, Eigen::VectorXd& /*diagonal*/,
-                              ElementMatrices& blocks) {
+void StrainLimitTerm::hessian(const Eigen::VectorXd& x,
+                              const std::vector<bool>& /*fixed_vertices*/,
+                              Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
   blocks.reset(3, {});
   for (const StrainLimitEnergy& energy : energies_) {
     energy.hessian(x, shell_blocks_);

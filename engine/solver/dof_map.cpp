@@ -24,4 +24,10 @@ Eigen::VectorXd DofMap::extend(const Eigen::VectorXd& reduced_values) const {
   return out;
 }
 
+std::vector<bool> DofMap::fixed_vertices() const {
+  std::vector<bool> fixed(reduced_.size() / 3);
+  for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = reduced_[3 * v] < 0;
+  return fixed;
+}
+
 }  // namespace psq

@@ -20,6 +20,8 @@ class DofMap {
   [[nodiscard]] Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
   /// A full vector with `reduced_values` at the free DOFs and zero at the fixed ones.
   [[nodiscard]] Eigen::VectorXd extend(const Eigen::VectorXd& reduced_values) const;
+  /// Per vertex, whether it is fixed (pinned vertices are fixed whole).
+  [[nodiscard]] std::vector<bool> fixed_vertices() const;
 
  private:
   std::vector<int> reduced_;

@@ -129,6 +129,7 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
       throw NumericalError(fmt::format("initial position is {} at {}", x[i], dof_name(i)));
 
   NewtonResult result;
+  hessian_.fixed_vertices = dofs.fixed_vertices();
   // Nothing left to take and nothing to judge: a capped step resumed after its last iteration
   // ends as the uninterrupted one did, without a gradient, Hessian or factorization.
   if (settings.max_iterations == 0 && !settings.judge_final_iterate) {

@@ -14,6 +14,10 @@ namespace psq {
 struct HessianBlocks {
   Eigen::VectorXd diagonal;             ///< size 3n
   std::vector<ElementMatrices> batches; ///< reused between iterations; stencils may change
+  /// Set by the solver before it asks: per vertex, whether the solve holds it (empty: none).
+  /// Its rows never reach the system, so a term may project only the block of the vertices
+  /// that move (project_moving_block_to_psd).
+  std::vector<bool> fixed_vertices;
 };
 
 class Objective {

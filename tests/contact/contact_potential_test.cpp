@@ -14,6 +14,7 @@
 
 #include "engine/contact/intersection_check.hpp"
 #include "engine/core/error.hpp"
+#include "engine/core/psd_projection.hpp"
 #include "engine/mesh/generators.hpp"
 #include "engine/mesh/topology.hpp"
 #include "support/derivative_check.hpp"
@@ -130,6 +131,38 @@ TEST(ContactPotential, ProjectedBlocksArePositiveSemiDefinite) {
         Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff();
     EXPECT_GE(smallest, -1e-9 * h.norm());
   }
+}
+
+// With the lower sheet fixed (a collider), each block is the exact pair Hessian's block over
+// the moving vertices, projected, and nothing on the fixed rows.
+TEST(ContactPotential, ProjectsEachBlockOverTheVerticesThatMove) {
+  TwoSheets sheets = sheets_in_contact();
+  const int n = static_cast<int>(sheets.x.size() / 3);
+  std::vector<bool> fixed(n, false);
+  std::fill_n(fixed.begin(), sheets.lower_vertices, true);
+  ContactPotential contact(sheets.surface, parameters());
+  ElementMatrices exact, projected;
+  contact.hessian(sheets.x, exact, false);
+  contact.hessian(sheets.x, projected, true, fixed);
+  ASSERT_EQ(projected.element_count(), exact.element_count());
+  ASSERT_GT(projected.element_count(), 0u);
+  int clamped = 0;
+  for (std::size_t e = 0; e < exact.element_count(); ++e) {
+    Eigen::MatrixXd reference = exact.block(e);
+    for (int i = 0; i < 4; ++i)
+      if (fixed[projected.vertices[4 * e + i]]) {
+        reference.middleRows<3>(3 * i).setZero();
+        reference.middleCols<3>(3 * i).setZero();
+      }
+    const Eigen::MatrixXd unprojected = reference;
+    project_to_psd(reference);
+    if ((reference - unprojected).norm() > 1e-9 * unprojected.norm()) ++clamped;
+    EXPECT_LE((Eigen::MatrixXd(projected.block(e)) - reference).norm(), 1e-9 * reference.norm())
+        << "pair " << e;
+  }
+  EXPECT_GT(clamped, 0) << "no block was indefinite: the test would not see a wrong projection";
+  std::vector<bool> too_few(n - 1, false);
+  EXPECT_THROW(contact.hessian(sheets.x, projected, true, too_few), std::invalid_argument);
 }
 
 TEST(ContactPotential, BarrierGrowsWithoutBoundAsTheGapCloses) {

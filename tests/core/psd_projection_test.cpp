@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <array>
 #include <cstdlib>
 #include <vector>
 
@@ -75,6 +76,55 @@ TEST(PsdProjection, TranslationInvariantPositiveSemiDefiniteBlocksStayUnchanged)
   const Eigen::Matrix<double, 12, 12> before = m;
   project_translation_invariant_to_psd(m);
   EXPECT_EQ(m, before);
+}
+
+TEST(PsdProjection, MovingBlocksProjectLikeTheFullEigensolverOnTheMovingRows) {
+  // The solve never sees a fixed point's rows: the reference zeroes them, then projects all 12.
+  struct Case {
+    std::vector<int> points;
+    std::array<bool, 4> fixed;
+  };
+  const std::vector<Case> cases = {
+      {{0, 1, 2, 3}, {false, true, true, true}},   // a point against a collider's triangle
+      {{0, 1, 2, 3}, {false, false, true, true}},  // a shell edge against a collider's edge
+      {{0, 1, 2, 3}, {true, false, false, false}},  // a pinned point against a shell triangle
+      {{0, 2, 3}, {false, true, true, false}},      // a point against a collider's edge
+      {{1, 3}, {false, false, false, true}}};      // a point against a collider's vertex
+  unsigned seed = 11;
+  for (const Case& c : cases) {
+    Eigen::Matrix<double, 12, 12> moving = translation_invariant_hessian(c.points, seed++);
+    for (int p = 0; p < 4; ++p)
+      if (c.fixed[p]) {
+        moving.middleRows<3>(3 * p).setZero();
+        moving.middleCols<3>(3 * p).setZero();
+      }
+    Eigen::MatrixXd full = moving;
+    ASSERT_LT(smallest_eigenvalue(full), -1e-3 * full.norm());
+    moving = translation_invariant_hessian(c.points, seed - 1);
+    project_moving_block_to_psd(moving, c.fixed);
+    project_to_psd(full);
+    EXPECT_LT((moving - full).norm(), 1e-12 * full.norm()) << c.points.size() << " points";
+  }
+}
+
+TEST(PsdProjection, MovingBlocksWithNothingFixedProjectAsTranslationInvariantOnes) {
+  Eigen::Matrix<double, 12, 12> moving = translation_invariant_hessian({0, 1, 2, 3}, 7);
+  Eigen::Matrix<double, 12, 12> invariant = moving;
+  // A fixed point the pair does not depend on fixes nothing.
+  Eigen::Matrix<double, 12, 12> unused = translation_invariant_hessian({0, 1, 2}, 8);
+  Eigen::Matrix<double, 12, 12> unused_reference = unused;
+  project_moving_block_to_psd(moving, {false, false, false, false});
+  project_translation_invariant_to_psd(invariant);
+  EXPECT_EQ(moving, invariant);
+  project_moving_block_to_psd(unused, {false, false, false, true});
+  project_translation_invariant_to_psd(unused_reference);
+  EXPECT_EQ(unused, unused_reference);
+}
+
+TEST(PsdProjection, MovingBlocksOfFixedPointsOnlyVanish) {
+  Eigen::Matrix<double, 12, 12> m = translation_invariant_hessian({0, 1, 2, 3}, 9);
+  project_moving_block_to_psd(m, {true, true, true, true});
+  EXPECT_TRUE(m.isZero(0.0));
 }
 
 }  // namespace
