@@ -9,156 +9,31 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <regex>
-#include <thread>
 
 #include "db/job_store.hpp"
-#include "engine/io/checkpoint.hpp"
-#include "runner/cantilever_workspace.hpp"
-#include "support/run_process.hpp"
+#include "runner/slurm_cluster.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-/// The sweep: four cantilevers of 200 frames (5-10 s each, long enough to act mid-level).
-struct SlurmSweep : test::CantileverWorkspace {
-  explicit SlurmSweep(const std::string& name) : CantileverWorkspace(name) {
-    const test::ProcessResult added =
-        add_sweep("k",
-                  "\"shell.strip.material.thickness\" = [5e-4, 6e-4, 7e-4, 8e-4]\n"
-                  "\"shell.strip.material.youngs_modulus\" = [5e6]\n"
-                  "\"time.frames\" = [200]\n");
-    EXPECT_EQ(added.exit_code, 0) << added.errors;
-  }
-  Checkpoint final_checkpoint(const std::string& job) const {
-    return read_checkpoint(dir / "runs" / job / "level_0.h5");
-  }
-};
-
-test::ProcessResult run(const std::string& program, const std::vector<std::string>& arguments) {
-  return test::run_process(program, arguments);
-}
-
-bool node_ready() {
-  const std::string state =
-      run("/usr/bin/sinfo", {"--noheader", "--nodes=localhost", "--format=%T"}).output;
-  return state.starts_with("idle") || state.starts_with("mixed") || state.starts_with("allocated");
-}
-
-/// Uses the localhost cluster, starting it (as root) if its node is not ready. Never skips: a
-/// cluster that cannot start fails the test.
-void require_cluster() {
-  if (node_ready()) return;
-  const test::ProcessResult started =
-      run((test::source_dir() / "scripts/slurm-localhost.sh").string(), {"start"});
-  ASSERT_EQ(started.exit_code, 0) << "the localhost SLURM cluster did not start (run as root; see "
-                                     "scripts/slurm-localhost.sh):\n"
-                                  << started.output << started.errors;
-  ASSERT_TRUE(node_ready());
-}
-
-struct Seen {
-  std::string state;
-  std::string reason;
-};
-
-/// array task name ("A_i") → SLURM state and reason, from squeue.
-std::map<std::string, Seen> task_states(const std::string& array_id) {
-  const test::ProcessResult q = run("/usr/bin/squeue", {"--noheader", "--array", "--states=all",
-                                                        "--jobs=" + array_id, "--format=%i %T %r"});
-  std::map<std::string, Seen> states;
-  std::istringstream lines(q.output);
-  for (std::string task, state, reason; lines >> task >> state >> reason;)
-    states[task] = {state, reason};
-  return states;
-}
-
-bool is_live(const std::string& state) {
-  return state == "PENDING" || state == "RUNNING" || state == "COMPLETING" || state == "REQUEUED" ||
-         state == "CONFIGURING";
-}
-
-/// A requeued task waits two minutes (SLURM's requeue delay); an administrator may start it
-/// sooner, but not within the second of the requeue: slurmd refuses a launch whose credential
-/// is no newer than the revoked one of the killed instance ("Job credential revoked").
-void start_requeued_now(const std::string& array_id) {
-  static std::map<std::string, Clock::time_point> first_seen;
-  for (const auto& [task, seen] : task_states(array_id)) {
-    if (seen.state != "PENDING" || seen.reason != "BeginTime") {
-      first_seen.erase(task);
-      continue;
-    }
-    const auto [at, added] = first_seen.emplace(task, Clock::now());
-    if (Clock::now() - at->second > std::chrono::seconds(3)) {
-      run("/usr/bin/scontrol", {"update", "JobId=" + task, "StartTime=now"});
-      first_seen.erase(at);
-    }
-  }
-}
-
-void wait_until(const std::function<bool()>& done, double seconds, const std::string& what,
-                const std::string& array_id) {
-  const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-  while (!done()) {
-    ASSERT_LT(Clock::now(), deadline) << "timed out waiting for " << what;
-    start_requeued_now(array_id);
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  }
-}
-
-std::string submitted_array(const test::ProcessResult& submit) {
-  std::smatch match;
-  EXPECT_TRUE(std::regex_search(submit.output, match, std::regex("array job ([0-9]+)")))
-      << submit.output << submit.errors;
-  return match.size() > 1 ? match[1].str() : "";
-}
+using test::all_task_logs;
+using test::array_ended;
+using test::count;
+using test::expect_equal_to_local_run;
+using test::is_live;
+using test::require_cluster;
+using test::run;
+using test::SlurmSweep;
+using test::submitted_array;
+using test::task_states;
+using test::wait_until;
 
 /// Every level_0 snapshot or checkpoint of the job: it is mid-level once one exists.
 bool has_snapshot(const SlurmSweep& sweep, const std::string& job) {
   return fs::exists(sweep.dir / "runs" / job / "level_0.snapshot.h5");
-}
-
-/// The text of every task log of every submission of the sweep.
-std::string all_task_logs(const SlurmSweep& sweep) {
-  std::string text;
-  for (const auto& entry : fs::recursive_directory_iterator(sweep.dir / "slurm"))
-    if (entry.path().extension() == ".log") text += test::read_file(entry.path());
-  return text;
-}
-
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
-
-void expect_equal_to_local_run(const SlurmSweep& cluster, const SlurmSweep& local) {
-  const std::vector<db::JobResult> expected = local.results();
-  const std::vector<db::JobResult> actual = cluster.results();
-  ASSERT_EQ(actual.size(), expected.size());
-  for (std::size_t j = 0; j < actual.size(); ++j) {
-    SCOPED_TRACE(actual[j].job.id);
-    ASSERT_EQ(actual[j].job.id, expected[j].job.id);
-    EXPECT_EQ(actual[j].job.state, db::JobState::done) << actual[j].job.error;
-    ASSERT_EQ(actual[j].levels.size(), expected[j].levels.size());
-    for (std::size_t l = 0; l < actual[j].levels.size(); ++l) {
-      EXPECT_EQ(actual[j].levels[l].status, db::LevelStatus::done);
-      EXPECT_EQ(actual[j].levels[l].iterations, expected[j].levels[l].iterations);
-      ASSERT_EQ(actual[j].levels[l].residuals.size(), expected[j].levels[l].residuals.size());
-      for (std::size_t k = 0; k < actual[j].levels[l].residuals.size(); ++k)
-        EXPECT_NEAR(actual[j].levels[l].residuals[k], expected[j].levels[l].residuals[k],
-                    1e-9 * (1.0 + std::abs(expected[j].levels[l].residuals[k])));
-    }
-    const Checkpoint a = cluster.final_checkpoint(actual[j].job.id);
-    const Checkpoint b = local.final_checkpoint(expected[j].job.id);
-    ASSERT_EQ(a.positions.rows(), b.positions.rows());
-    EXPECT_LE((a.positions - b.positions).cwiseAbs().maxCoeff(), 1e-12);
-  }
 }
 
 TEST(Slurm, RequeuedKilledAndTimedOutTasksResumeAndSyncToTheLocalResult) {
@@ -194,13 +69,7 @@ TEST(Slurm, RequeuedKilledAndTimedOutTasksResumeAndSyncToTheLocalResult) {
   // Task 2: the warning before its time limit; it checkpoints and requeues itself.
   wait_until([&] { return has_snapshot(sweep, jobs[2]); }, 60, "task 2 mid-level", array);
   EXPECT_EQ(run("/usr/bin/scancel", {"--batch", "--signal=USR1", task(2)}).exit_code, 0);
-  wait_until(
-      [&] {
-        for (const auto& [name, seen] : task_states(array))
-          if (is_live(seen.state)) return false;
-        return true;
-      },
-      150, "the array to end", array);
+  wait_until([&] { return array_ended(array); }, 150, "the array to end", array);
 
   // Sync brings in the three that ended with a result and requeues the killed task in SLURM:
   // the same task, still holding its claim, continues from its checkpoint.
