@@ -65,12 +65,16 @@ std::map<std::string, Seen> task_states(const std::string& array_id) {
 }
 
 bool is_live(const std::string& state) {
+  // SIGNALING: a running task while slurmctld delivers its --signal warning.
   return state == "PENDING" || state == "RUNNING" || state == "COMPLETING" || state == "REQUEUED" ||
-         state == "CONFIGURING";
+         state == "CONFIGURING" || state == "SIGNALING";
 }
 
 bool array_ended(const std::string& array_id) {
-  for (const auto& [name, seen] : task_states(array_id))
+  const std::map<std::string, Seen> states = task_states(array_id);
+  // An array squeue does not list (it failed, say, under load) has not been seen to end.
+  if (states.empty()) return false;
+  for (const auto& [name, seen] : states)
     if (is_live(seen.state)) return false;
   return true;
 }
