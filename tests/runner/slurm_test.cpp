@@ -1,9 +1,10 @@
 // `psq slurm` against the single-node cluster of scripts/slurm-localhost.sh (started here if
 // it is not running; this test fails, never skips, when it cannot be). A 4-job sweep runs as
 // an array: one task is requeued mid-level (scontrol requeue), one killed mid-level (scancel
-// --batch --signal=KILL: no chance to checkpoint; sync requeues it in SLURM), one gets SLURM's time-limit warning
-// (SIGUSR1, as --signal=B:USR1@S sends it) mid-level and requeues itself; each continues from
-// its last checkpoint, and after sync every job is done once with the result of a local run.
+// --batch --signal=KILL: no chance to checkpoint; sync requeues it in SLURM), one gets SLURM's
+// time-limit warning (SIGUSR1, as --signal=B:USR1@S sends it, here by hand; a real --time in
+// slurm_time_limit_test.cpp) mid-level and requeues itself; each continues from its last
+// checkpoint, and after sync every job is done once with the result of a local run.
 // Bad input: no sbatch, a cluster that does not answer, an unknown partition.
 
 #include <fmt/format.h>
