@@ -14,8 +14,7 @@
 
 namespace psq::test {
 
-/// The [grid] of the sweep `k` unless a test gives its own: four cantilevers of 200 frames
-/// (5-10 s each, long enough to act mid-level).
+/// The [grid] of the sweep `k` unless a test gives its own: four cantilevers of 200 frames.
 extern const char* const kFourCantilevers;
 
 /// A workspace whose store holds the sweep `k` of `grid`.
