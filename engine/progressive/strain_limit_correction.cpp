@@ -34,9 +34,10 @@ constexpr int kMaxIterations = 100;
 /// A solve ends early when its best state has not improved by this fraction of the tightest
 /// triangle's remaining excess over kStalledChecks checks in a row: the vertices it moves cannot
 /// restore the limit. The tightest triangle is a maximum over a sum Newton minimizes, so one
-/// check may be worse than the one before while the sum still falls.
+/// check may be worse than the one before while the sum still falls, and the best one may
+/// stand for several checks before the sum's descent lowers it again.
 constexpr double kLeastProgress = 0.01;
-constexpr int kStalledChecks = 3;
+constexpr int kStalledChecks = 6;
 /// Newton's step tolerance, relative to the bounding-box diagonal: the correction needs the
 /// stretches below their accepted bound, not the minimizer of V to many digits.
 constexpr double kCorrectionTolerance = 1e-6;
