@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 
 namespace psq {
@@ -27,12 +28,41 @@ void check_sizes(const HessianBlocks& blocks, const DofMap& dofs) {
   }
 }
 
-/// Slot of entry (row, col) in a compressed-column pattern whose columns hold sorted rows.
-int find_slot(const Eigen::SparseMatrix<double>& pattern, int row, int col) {
+/// Slot of entry (row, col) in a compressed-column pattern whose columns hold sorted rows,
+/// searched from slot `from` of that column on (a slot whose row is at most `row`) when given.
+int find_slot(const Eigen::SparseMatrix<double>& pattern, int row, int col, int from = -1) {
   const int* inner = pattern.innerIndexPtr();
-  const int* first = inner + pattern.outerIndexPtr()[col];
+  const int* first = inner + std::max(from, pattern.outerIndexPtr()[col]);
   const int* last = inner + pattern.outerIndexPtr()[col + 1];
   return static_cast<int>(std::lower_bound(first, last, row) - inner);
+}
+
+/// The slots of one element's upper entries, packed as the scatter reads them ((i, j), i ≤ j,
+/// at j(j+1)/2 + i), given the reduced index of each local DOF (−1: fixed). The entries are
+/// visited column by column in increasing reduced order: a column holds sorted, distinct rows,
+/// and the pattern holds every entry of the element, so a row one above the previous one lies in
+/// the next slot, and only the first row of each vertex's run is searched for.
+void element_slots(const Eigen::SparseMatrix<double>& pattern, const std::vector<int>& local,
+                   std::vector<int>& order, int* slots) {
+  const int m = static_cast<int>(local.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return local[a] < local[b]; });
+  for (int jj = 0; jj < m; ++jj) {
+    const int col = local[order[jj]];
+    int previous_row = -2, previous_slot = -1;
+    for (int ii = 0; ii <= jj; ++ii) {
+      const int row = local[order[ii]];  // row ≤ col
+      int slot = -1;
+      if (row >= 0) {
+        slot = row == previous_row + 1 ? previous_slot + 1
+                                       : find_slot(pattern, row, col, previous_slot);
+        previous_row = row;
+        previous_slot = slot;
+      }
+      const int i = std::min(order[ii], order[jj]), j = std::max(order[ii], order[jj]);
+      slots[j * (j + 1) / 2 + i] = slot;
+    }
+  }
 }
 
 bool repeats_a_vertex(const int* stencil, int size) {
@@ -210,12 +240,10 @@ void SparseAssembler::rebuild_batch_map(const ElementMatrices& batch, BatchMap& 
   // contact pairs come and go, redoes them for every element of every batch.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.element_count(), 256),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<int> local(m);
+                      std::vector<int> local(m), order(m);
                       for (std::size_t e = range.begin(); e != range.end(); ++e) {
                         local_dofs(e, local);
-                        int* slot = map.slots.data() + e * upper_size;
-                        for (int j = 0; j < m; ++j)
-                          for (int i = 0; i <= j; ++i) *slot++ = upper_slot(local[i], local[j]);
+                        element_slots(matrix_, local, order, map.slots.data() + e * upper_size);
                       }
                     });
   // Two local DOFs coincide only where the stencil lists a vertex twice. In element order, so
@@ -232,10 +260,6 @@ void SparseAssembler::rebuild_batch_map(const ElementMatrices& batch, BatchMap& 
           map.mirrored.emplace_back(e * batch.block_size() + static_cast<std::size_t>(i) * m + j,
                                     *slot);
   }
-}
-
-int SparseAssembler::upper_slot(int row, int col) const {
-  return row < 0 || col < 0 ? -1 : find_slot(matrix_, std::min(row, col), std::max(row, col));
 }
 
 void SparseAssembler::scatter(const HessianBlocks& blocks) {

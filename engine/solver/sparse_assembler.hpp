@@ -55,8 +55,6 @@ class SparseAssembler {
   void rebuild_scatter_map(const HessianBlocks& blocks, const DofMap& dofs, bool pattern_changed);
   /// One batch's slots in the current pattern and DOF numbering (reduced_).
   void rebuild_batch_map(const ElementMatrices& batch, BatchMap& map) const;
-  /// The slot of entry (min, max) of two reduced DOFs, −1 when either is fixed.
-  [[nodiscard]] int upper_slot(int row, int col) const;
   void scatter(const HessianBlocks& blocks);
 
   Eigen::SparseMatrix<double> matrix_;
