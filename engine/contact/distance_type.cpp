@@ -10,10 +10,12 @@
 namespace psq {
 namespace {
 
-/// True when sin²θ between a and b is below kCollinearSineSquared, and when either is zero
-/// (from ‖a × b‖² = ‖a‖²‖b‖² sin²θ, no division).
-bool is_collinear(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return !(a.cross(b).squaredNorm() > kCollinearSineSquared * a.squaredNorm() * b.squaredNorm());
+/// True when sin²θ between a and b, whose cross product is `a_cross_b`, is below
+/// kCollinearSineSquared, and when either is zero (from ‖a × b‖² = ‖a‖²‖b‖² sin²θ, no
+/// division). The callers need the cross product themselves.
+bool is_collinear(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                  const Eigen::Vector3d& a_cross_b) {
+  return !(a_cross_b.squaredNorm() > kCollinearSineSquared * a.squaredNorm() * b.squaredNorm());
 }
 
 /// The nearest of several point–edge pairs: the index of the pair and its case. Ties keep the
@@ -56,8 +58,9 @@ PointEdgeCase point_edge_case(const Eigen::Vector3d& p, const Eigen::Vector3d& e
 
 PointTriangleCase point_triangle_case(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
                                       const Eigen::Vector3d& t1, const Eigen::Vector3d& t2) {
-  const Eigen::Vector3d n = (t1 - t0).cross(t2 - t0);
-  if (!is_collinear(t1 - t0, t2 - t0) && projects_inside_edge(n, p, t0, t1) &&
+  const Eigen::Vector3d a = t1 - t0, b = t2 - t0;
+  const Eigen::Vector3d n = a.cross(b);
+  if (!is_collinear(a, b, n) && projects_inside_edge(n, p, t0, t1) &&
       projects_inside_edge(n, p, t1, t2) && projects_inside_edge(n, p, t2, t0))
     return PointTriangleCase::Face;
 
@@ -79,10 +82,10 @@ EdgeEdgeCase edge_edge_case(const Eigen::Vector3d& ea0, const Eigen::Vector3d& e
                             const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   const Eigen::Vector3d u = ea1 - ea0;
   const Eigen::Vector3d v = eb1 - eb0;
-  if (!is_collinear(u, v)) {
+  const Eigen::Vector3d n = u.cross(v);
+  if (!is_collinear(u, v, n)) {
     // Unconstrained minimiser (s, t) of ‖ea0 + s u − eb0 − t v‖², scaled by ‖n‖² > 0.
     const Eigen::Vector3d w0 = ea0 - eb0;
-    const Eigen::Vector3d n = u.cross(v);
     const double n_sq = n.squaredNorm();
     const double s = n.dot(v.cross(w0));
     const double t = n.dot(u.cross(w0));
