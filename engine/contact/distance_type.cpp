@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -18,11 +19,12 @@ bool is_collinear(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return !(a_cross_b.squaredNorm() > kCollinearSineSquared * a.squaredNorm() * b.squaredNorm());
 }
 
-/// The nearest of several point–edge pairs: the index of the pair and its case. Ties keep the
-/// first, so the choice is deterministic.
+/// The nearest of several point–edge pairs: the index of the pair and its case, and its
+/// squared distance in `distance` when given. Ties keep the first, so the choice is
+/// deterministic.
 template <std::size_t Count>
 std::pair<std::size_t, PointEdgeCase> nearest_point_edge(
-    const std::array<std::array<const Eigen::Vector3d*, 3>, Count>& pairs) {
+    const std::array<std::array<const Eigen::Vector3d*, 3>, Count>& pairs, double* distance) {
   std::size_t best = 0;
   double best_distance = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < Count; ++i) {
@@ -34,6 +36,10 @@ std::pair<std::size_t, PointEdgeCase> nearest_point_edge(
     }
   }
   const auto& [p, e0, e1] = pairs[best];
+  // No distance below infinity (NaN coordinates): the first pair's own value, NaN included,
+  // so that a non-finite state reaches the barrier.
+  if (distance != nullptr)
+    *distance = std::isinf(best_distance) ? point_edge_distance(*p, *e0, *e1) : best_distance;
   return {best, point_edge_case(*p, *e0, *e1)};
 }
 
@@ -57,7 +63,8 @@ PointEdgeCase point_edge_case(const Eigen::Vector3d& p, const Eigen::Vector3d& e
 }
 
 PointTriangleCase point_triangle_case(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
-                                      const Eigen::Vector3d& t1, const Eigen::Vector3d& t2) {
+                                      const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
+                                      double* boundary_distance) {
   const Eigen::Vector3d a = t1 - t0, b = t2 - t0;
   const Eigen::Vector3d n = a.cross(b);
   if (!is_collinear(a, b, n) && projects_inside_edge(n, p, t0, t1) &&
@@ -67,7 +74,7 @@ PointTriangleCase point_triangle_case(const Eigen::Vector3d& p, const Eigen::Vec
   // Outside the face region the distance, a convex function on the triangle, is smallest on
   // its boundary: at the nearest of the three edges.
   const auto [edge, edge_case] =
-      nearest_point_edge<3>({{{&p, &t0, &t1}, {&p, &t1, &t2}, {&p, &t2, &t0}}});
+      nearest_point_edge<3>({{{&p, &t0, &t1}, {&p, &t1, &t2}, {&p, &t2, &t0}}}, boundary_distance);
   // Per edge: the case when the closest point is its first endpoint, its second endpoint, or
   // inside it (indexed by PointEdgeCase).
   constexpr std::array<std::array<PointTriangleCase, 3>, 3> kCases{{
@@ -79,7 +86,8 @@ PointTriangleCase point_triangle_case(const Eigen::Vector3d& p, const Eigen::Vec
 }
 
 EdgeEdgeCase edge_edge_case(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
-                            const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
+                            const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
+                            double* boundary_distance) {
   const Eigen::Vector3d u = ea1 - ea0;
   const Eigen::Vector3d v = eb1 - eb0;
   const Eigen::Vector3d n = u.cross(v);
@@ -95,7 +103,8 @@ EdgeEdgeCase edge_edge_case(const Eigen::Vector3d& ea0, const Eigen::Vector3d& e
   // Otherwise the minimum over [0, 1]² lies on the square's boundary: an endpoint of one edge
   // against the other edge.
   const auto [pair, edge_case] = nearest_point_edge<4>(
-      {{{&ea0, &eb0, &eb1}, {&ea1, &eb0, &eb1}, {&eb0, &ea0, &ea1}, {&eb1, &ea0, &ea1}}});
+      {{{&ea0, &eb0, &eb1}, {&ea1, &eb0, &eb1}, {&eb0, &ea0, &ea1}, {&eb1, &ea0, &ea1}}},
+      boundary_distance);
   // Per candidate: the case when the closest point is the edge's first endpoint, its second
   // endpoint, or inside it (indexed by PointEdgeCase).
   constexpr std::array<std::array<EdgeEdgeCase, 3>, 4> kCases{{

@@ -63,16 +63,22 @@ PointEdgeCase point_edge_case(const Eigen::Vector3d& p, const Eigen::Vector3d& e
 /// edge (ti, tj), n·((tj − ti) × (p − ti)) ≥ 0 with n = (t1 − t0) × (t2 − t0)); otherwise
 /// the closest point lies on the boundary and the case is that of the nearest of the three
 /// edges (point_edge_case). Sliver triangles (sin² of the angle at t0 below
-/// kCollinearSineSquared) never give Face.
+/// kCollinearSineSquared) never give Face. Outside Face, `boundary_distance` (when given)
+/// receives the squared distance to the nearest edge, found on the way: the value
+/// point_feature_distance gives for the case, to the bit.
 PointTriangleCase point_triangle_case(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
-                                      const Eigen::Vector3d& t1, const Eigen::Vector3d& t2);
+                                      const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
+                                      double* boundary_distance = nullptr);
 
 /// The closest features of two edges. The distance ‖ea0 + s u − eb0 − t v‖² (u = ea1 − ea0,
 /// v = eb1 − eb0) is convex in (s, t): LineLine when its unconstrained minimiser lies strictly
 /// inside [0, 1]², otherwise the minimum over the square is on its boundary and the case is
 /// that of the nearest of the four endpoint–edge pairs. Near-parallel edges (sin²θ below
-/// kCollinearSineSquared, zero-length edges included) always take the boundary route.
+/// kCollinearSineSquared, zero-length edges included) always take the boundary route; there
+/// `boundary_distance` (when given) receives the squared distance of the nearest pair, as for
+/// point_triangle_case.
 EdgeEdgeCase edge_edge_case(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
-                            const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1);
+                            const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
+                            double* boundary_distance = nullptr);
 
 }  // namespace psq

@@ -42,9 +42,9 @@ StencilDerivatives<12> line_line_distance_derivatives(const Eigen::Vector3d& ea0
 
 double edge_edge_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                           const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
-  const EdgeEdgeCase c = edge_edge_case(ea0, ea1, eb0, eb1);
-  if (c == EdgeEdgeCase::LineLine) return line_line_distance(ea0, ea1, eb0, eb1);
-  return point_feature_distance(point_feature(c), stack_stencil(ea0, ea1, eb0, eb1));
+  double boundary_distance = 0.0;
+  const EdgeEdgeCase c = edge_edge_case(ea0, ea1, eb0, eb1, &boundary_distance);
+  return c == EdgeEdgeCase::LineLine ? line_line_distance(ea0, ea1, eb0, eb1) : boundary_distance;
 }
 
 StencilDerivatives<12> edge_edge_distance_derivatives(const Eigen::Vector3d& ea0,

@@ -37,9 +37,9 @@ StencilDerivatives<12> point_plane_distance_derivatives(const Eigen::Vector3d& p
 
 double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& t0,
                                const Eigen::Vector3d& t1, const Eigen::Vector3d& t2) {
-  const PointTriangleCase c = point_triangle_case(p, t0, t1, t2);
-  if (c == PointTriangleCase::Face) return point_plane_distance(p, t0, t1, t2);
-  return point_feature_distance(point_feature(c), stack_stencil(p, t0, t1, t2));
+  double boundary_distance = 0.0;
+  const PointTriangleCase c = point_triangle_case(p, t0, t1, t2, &boundary_distance);
+  return c == PointTriangleCase::Face ? point_plane_distance(p, t0, t1, t2) : boundary_distance;
 }
 
 StencilDerivatives<12> point_triangle_distance_derivatives(const Eigen::Vector3d& p,
