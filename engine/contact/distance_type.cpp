@@ -2,7 +2,6 @@
 
 #include <Eigen/Geometry>
 #include <array>
-#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -27,20 +26,21 @@ std::pair<std::size_t, PointEdgeCase> nearest_point_edge(
     const std::array<std::array<const Eigen::Vector3d*, 3>, Count>& pairs, double* distance) {
   std::size_t best = 0;
   double best_distance = std::numeric_limits<double>::infinity();
+  std::array<PointEdgeCase, Count> cases;
+  std::array<double, Count> distances;
   for (std::size_t i = 0; i < Count; ++i) {
     const auto& [p, e0, e1] = pairs[i];
-    const double d = point_edge_distance(*p, *e0, *e1);
-    if (d < best_distance) {
+    cases[i] = point_edge_case(*p, *e0, *e1);
+    distances[i] = point_edge_distance(*p, *e0, *e1, cases[i]);
+    if (distances[i] < best_distance) {
       best = i;
-      best_distance = d;
+      best_distance = distances[i];
     }
   }
-  const auto& [p, e0, e1] = pairs[best];
-  // No distance below infinity (NaN coordinates): the first pair's own value, NaN included,
-  // so that a non-finite state reaches the barrier.
-  if (distance != nullptr)
-    *distance = std::isinf(best_distance) ? point_edge_distance(*p, *e0, *e1) : best_distance;
-  return {best, point_edge_case(*p, *e0, *e1)};
+  // With no distance below infinity (NaN coordinates) the first pair's own value is given, NaN
+  // included, so that a non-finite state reaches the barrier.
+  if (distance != nullptr) *distance = distances[best];
+  return {best, cases[best]};
 }
 
 /// Whether p projects onto the inner side of the edge (ti, tj) of a triangle with normal n

@@ -67,7 +67,12 @@ StencilDerivatives<9> point_line_distance_derivatives(const Eigen::Vector3d& p,
 
 double point_edge_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
                            const Eigen::Vector3d& e1) {
-  switch (point_edge_case(p, e0, e1)) {
+  return point_edge_distance(p, e0, e1, point_edge_case(p, e0, e1));
+}
+
+double point_edge_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
+                           const Eigen::Vector3d& e1, PointEdgeCase edge_case) {
+  switch (edge_case) {
     case PointEdgeCase::Vertex0:
       return point_point_distance(p, e0);
     case PointEdgeCase::Vertex1:

@@ -104,6 +104,9 @@ StencilDerivatives<9> point_line_distance_derivatives(const Eigen::Vector3d& p,
 /// Squared distance from p to the segment (e0, e1), through point_edge_case.
 double point_edge_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
                            const Eigen::Vector3d& e1);
+/// The same, given the case point_edge_case(p, e0, e1) already found.
+double point_edge_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& e0,
+                           const Eigen::Vector3d& e1, PointEdgeCase edge_case);
 
 /// point_edge_distance with its derivatives over the stencil (p, e0, e1), zero for the
 /// endpoint the distance does not depend on.
