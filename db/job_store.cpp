@@ -474,7 +474,8 @@ std::vector<PreviewPoint> JobStore::preview_points(std::int64_t sweep_id) {
   // Every job of the sweep that has its preview: waiting at it, or promoted past it. The last
   // preview level's outputs, and the one before it for rules on the change between the two.
   auto rows = connection_.prepare(
-      "SELECT jobs.id, jobs.parameters, jobs.preview_levels, levels.level, levels.outputs "
+      "SELECT jobs.id, jobs.parameters, jobs.preview_levels, levels.level, levels.outputs, "
+      "jobs.depth "
       "FROM jobs JOIN sweep_jobs ON sweep_jobs.job_id = jobs.id "
       "JOIN levels ON levels.job_id = jobs.id AND levels.status = 'done' "
       "AND levels.level >= jobs.preview_levels - 2 AND levels.level < jobs.preview_levels "
@@ -487,7 +488,7 @@ std::vector<PreviewPoint> JobStore::preview_points(std::int64_t sweep_id) {
       PreviewPoint& point = points.emplace_back();
       point.job_id = rows.text(0);
       const nlohmann::json parameters = nlohmann::json::parse(rows.text(1));
-      point.parameters["depth"] = parameters.at("depth").get<double>();
+      point.parameters["depth"] = static_cast<double>(rows.integer(5));
       const nlohmann::json overrides = parameters.value("overrides", nlohmann::json::object());
       for (const auto& [path, value] : overrides.items())
         if (value.is_number()) point.parameters[path] = value.get<double>();
