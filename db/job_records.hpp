@@ -49,7 +49,7 @@ struct NewJob {
   int depth = 1;              ///< number of hierarchy levels (1: a direct solve)
   int max_attempts = 3;       ///< failed attempts allowed before the job stays failed
   /// Levels run before the job waits for promotion (a coarse-first sweep); empty: all.
-  std::optional<int> preview_levels;
+  std::optional<int> preview_levels = std::nullopt;
 };
 
 /// Where and with what a job ran (its latest attempt).

@@ -148,8 +148,9 @@ TEST(CoarseFirstStore, TheLastPreviewPromotesTheSelectionAndOnlyItIsClaimedAgain
     EXPECT_EQ(claim_levels, 2);
     ids.push_back(s.run_next(values[i], 2, Outcome::previewed));
     // Nothing is promoted while previews are still to come.
-    if (i + 1 < values.size())
+    if (i + 1 < values.size()) {
       EXPECT_EQ(s.job(ids[i]).state, JobState::previewed);
+    }
   }
   EXPECT_EQ(s.job(ids[0]).state, JobState::queued);
   EXPECT_TRUE(s.job(ids[0]).promoted);

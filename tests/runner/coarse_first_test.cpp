@@ -140,6 +140,23 @@ TEST(CoarseFirst, TheRulePromotesItsSelectionWhichEndsAsARefineAllRunAndTheRestW
   const test::ProcessResult results = coarse.psq({"results", "cf"});
   EXPECT_NE(results.output.find("previewed depth=3"), std::string::npos) << results.output;
   EXPECT_NE(results.output.find("(preview: 2 levels, promoted)"), std::string::npos);
+
+  // The report puts every preview beside the refined answers, the selection marked.
+  const test::ProcessResult report =
+      coarse.psq({"report", "cf", "--out", (coarse.dir / "report").string()});
+  ASSERT_EQ(report.exit_code, 0) << report.errors;
+  const std::string summary = test::read_file(coarse.dir / "report" / "summary.md");
+  const auto section = summary.find("## Coarse-first selection");
+  ASSERT_NE(section, std::string::npos) << summary;
+  const std::string table = summary.substr(section, summary.find("## Levels") - section);
+  for (const db::JobResult& job : jobs) {
+    const auto row = table.find(job.job.id.substr(0, 8));
+    ASSERT_NE(row, std::string::npos) << table;
+    const std::string line = table.substr(row, table.find('\n', row) - row);
+    EXPECT_NE(line.find(selected.count(job.job.id) ? "| done | yes |" : "| previewed | no |"),
+              std::string::npos)
+        << line;
+  }
 }
 
 TEST(CoarseFirst, PromoteByHandRefinesTheChosenPreviewsFromTheirCheckpoints) {
