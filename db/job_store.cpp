@@ -409,6 +409,7 @@ void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& er
   // In the same transaction as the job's end, so that the last preview of a sweep (or its last
   // failure) and the promotion it triggers are one step that a killed worker cannot split.
   apply_settled_rules();
+  if (options_.inside_finish_transaction) options_.inside_finish_transaction();
   transaction.commit();
 }
 

@@ -35,6 +35,9 @@ struct JobStoreOptions {
   /// Test seam: called inside record_level's transaction, after the row is written and before
   /// the commit (to kill a process in the middle of a database write).
   std::function<void()> inside_record_transaction;
+  /// Test seam: called inside finish's transaction, after the job's end and any promotion it
+  /// triggers are written and before the commit.
+  std::function<void()> inside_finish_transaction;
 };
 
 /// One connection to a job store. Not thread-safe: use one JobStore per thread (e.g. a second

@@ -8,6 +8,7 @@
 #include "db/job_store.hpp"
 #include "db/refine_rule.hpp"
 #include "engine/core/error.hpp"
+#include "child_process.hpp"
 #include "store_fixtures.hpp"
 #include "support/test_paths.hpp"
 
@@ -99,6 +100,24 @@ TEST(RefineRules, StoredFormReadsBackToTheSameRule) {
   EXPECT_EQ(rule_of(RefineKind::none).preview_levels(3), 2);
 }
 
+/// Claims the next job of `store` and records its levels [0, levels) with max_displacement
+/// `value` (level 0 half of it), then ends the attempt as `outcome`.
+std::string run_next_job(JobStore& store, double value, int levels, Outcome outcome) {
+  const auto claim = store.claim_next(test::worker("w"), 30);
+  EXPECT_TRUE(claim);
+  for (int level = 0; level < levels; ++level) {
+    LevelRecord record;
+    record.level = level;
+    record.status = LevelStatus::done;
+    record.checkpoint_path = fmt::format("/runs/{}/level_{}.h5", claim->job.id, level);
+    record.checkpoint_checksum = "fnv1a64:0000000000000001";
+    record.outputs = {{"max_displacement", level + 1 == levels ? value : value / 2}};
+    store.record_level(claim->lease, record);
+  }
+  store.finish(claim->lease, outcome);
+  return claim->job.id;
+}
+
 /// A store with the coarse-first sweep "s" of `count` jobs of depth 3 (two preview levels).
 struct CoarseFirstStore {
   std::filesystem::path path = psq::test::fresh_temp_dir("db-coarse") / "psq.db";
@@ -111,22 +130,8 @@ struct CoarseFirstStore {
     store.add_sweep("s", "s.toml", jobs, rule);
   }
 
-  /// Claims the next job and records its levels [0, levels) with max_displacement `value`
-  /// (level 0 half of it), then ends the attempt as `outcome`.
   std::string run_next(double value, int levels, Outcome outcome) {
-    const auto claim = store.claim_next(test::worker("w"), 30);
-    EXPECT_TRUE(claim);
-    for (int level = 0; level < levels; ++level) {
-      LevelRecord record;
-      record.level = level;
-      record.status = LevelStatus::done;
-      record.checkpoint_path = fmt::format("/runs/{}/level_{}.h5", claim->job.id, level);
-      record.checkpoint_checksum = "fnv1a64:0000000000000001";
-      record.outputs = {{"max_displacement", level + 1 == levels ? value : value / 2}};
-      store.record_level(claim->lease, record);
-    }
-    store.finish(claim->lease, outcome);
-    return claim->job.id;
+    return run_next_job(store, value, levels, outcome);
   }
 
   Job job(const std::string& id) { return *store.find_job(id); }
@@ -168,6 +173,37 @@ TEST(CoarseFirstStore, TheLastPreviewPromotesTheSelectionAndOnlyItIsClaimedAgain
   EXPECT_EQ(second->job.id, ids[2]);
   EXPECT_FALSE(s.store.claim_next(test::worker("w"), 30));
   EXPECT_TRUE(s.store.promote("s", top_two()).promoted.empty());
+}
+
+TEST(CoarseFirstStore, AKillInsideTheLastPreviewsTransactionLosesNeitherPreviewNorPromotion) {
+  CoarseFirstStore s(2, top_two());
+  const std::string first = s.run_next(0.3, 2, Outcome::previewed);
+  test::Pipe inside;
+  test::ChildProcess doomed([&] {
+    JobStoreOptions options = s.clock.options();
+    options.inside_finish_transaction = [&] {
+      inside.signal();
+      ::pause();
+    };
+    JobStore store(s.path, options);
+    run_next_job(store, 0.1, 2, Outcome::previewed);
+  });
+  ASSERT_TRUE(inside.await());
+  doomed.kill_and_wait();
+  // The preview's end and its promotion were one transaction: both rolled back.
+  EXPECT_EQ(s.job(first).state, JobState::previewed);
+  EXPECT_FALSE(s.job(first).promoted);
+  EXPECT_EQ(s.store.status("s").counts.at(JobState::running), 1);
+  EXPECT_TRUE(s.store.integrity_problems().empty());
+  // Its lease expires; the job (with its recorded levels: progress) is run again, and its end
+  // promotes the selection.
+  s.clock.now += 60;
+  const std::string second = s.run_next(0.1, 2, Outcome::previewed);
+  EXPECT_NE(second, first);
+  EXPECT_EQ(s.job(second).attempt, 2);
+  EXPECT_EQ(s.job(second).failures, 0);
+  EXPECT_EQ(s.job(first).state, JobState::queued);
+  EXPECT_EQ(s.job(second).state, JobState::queued);
 }
 
 TEST(CoarseFirstStore, AFailedLastPreviewStillSettlesTheSweep) {
