@@ -41,9 +41,11 @@ struct CoarseFirstWorkspace : test::CantileverWorkspace {
 
   /// `psq work` in `processes` processes at once, one worker each; their stderr concatenated.
   std::string work(int processes) const {
+    const int run = runs++;
+    const auto logs_of = [&](int p) { return dir / "logs" / fmt::format("{}-{}", run, p); };
     std::vector<std::unique_ptr<test::PsqChild>> children;
     for (int p = 0; p < processes; ++p) {
-      const fs::path logs = dir / "logs" / fmt::format("{}-{}", runs++, p);
+      const fs::path logs = logs_of(p);
       fs::create_directories(logs);
       children.push_back(std::make_unique<test::PsqChild>(
           PSQ_EXECUTABLE, std::vector<std::string>{"work", "--db", db.string(), "--workers", "1"},
@@ -52,7 +54,7 @@ struct CoarseFirstWorkspace : test::CantileverWorkspace {
     std::string errors;
     for (int p = 0; p < processes; ++p) {
       EXPECT_EQ(children[p]->wait(), 0);
-      errors += test::read_file(dir / "logs" / fmt::format("{}-{}", runs - 1, p) / "child.err");
+      errors += test::read_file(logs_of(p) / "child.err");
     }
     return errors;
   }
@@ -128,7 +130,9 @@ TEST(CoarseFirst, TheRulePromotesItsSelectionWhichEndsAsARefineAllRunAndTheRestW
     }
   }
   // Two processes on one store: every preview ran once, every promoted job finished once.
-  for (const auto& [id, count] : count_lines(log, R"(job (\S+): previewed \()")) EXPECT_EQ(count, 1);
+  const auto previewed = count_lines(log, R"(job (\S+): previewed \()");
+  EXPECT_EQ(previewed.size(), 6u) << log;
+  for (const auto& [id, count] : previewed) EXPECT_EQ(count, 1) << id;
   const auto finished = count_lines(log, R"(job (\S+): done in )");
   EXPECT_EQ(finished.size(), 2u);
   for (const auto& [id, count] : finished) EXPECT_EQ(count, 1) << id;
