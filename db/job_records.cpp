@@ -9,7 +9,7 @@ namespace psq::db {
 namespace {
 
 constexpr std::array<std::string_view, kAllJobStates.size()> kJobStateNames{
-    "queued", "running", "done", "failed", "cancelled"};
+    "queued", "running", "done", "failed", "cancelled", "previewed"};
 constexpr std::array<std::string_view, 3> kLevelStatusNames{"running", "done", "failed"};
 
 template <class Enum, std::size_t N>

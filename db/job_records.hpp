@@ -12,14 +12,19 @@
 #include <utility>
 #include <vector>
 
+#include "db/refine_rule.hpp"
+
 namespace psq::db {
 
 /// Where a job is in its life. queued → running → done; running → queued (released, or a
 /// failed attempt with attempts left, or a lease that expired); running → failed (no attempts
 /// left, or a permanent failure); queued/running → cancelled; failed/cancelled → queued (retry).
-enum class JobState { queued, running, done, failed, cancelled };
-inline constexpr std::array kAllJobStates{JobState::queued, JobState::running, JobState::done,
-                                          JobState::failed, JobState::cancelled};
+/// A job of a coarse-first sweep stops at its preview levels: running → previewed; promoted,
+/// previewed → queued, and it then runs its finer levels.
+enum class JobState { queued, running, done, failed, cancelled, previewed };
+inline constexpr std::array kAllJobStates{JobState::queued,    JobState::running,
+                                          JobState::done,      JobState::failed,
+                                          JobState::cancelled, JobState::previewed};
 std::string_view to_string(JobState state);
 /// Throws std::invalid_argument for a name that is not a state.
 JobState job_state_from_string(std::string_view name);
@@ -31,8 +36,9 @@ std::string_view to_string(LevelStatus status);
 LevelStatus level_status_from_string(std::string_view name);
 
 /// How an attempt ended. `failed` is retried while attempts remain; `failed_permanently`
-/// (input the user must fix: retrying cannot help) ends the job at once.
-enum class Outcome { done, failed, failed_permanently };
+/// (input the user must fix: retrying cannot help) ends the job at once; `previewed`: the job
+/// ran the levels it was to run before promotion (Job::levels_to_run).
+enum class Outcome { done, failed, failed_permanently, previewed };
 
 /// A job as a sweep submits it. `id` is the hash of the canonical parameters (computed by the
 /// sweep expansion); the same id always means the same job.
@@ -42,6 +48,8 @@ struct NewJob {
   std::string scene;          ///< the scene file
   int depth = 1;              ///< number of hierarchy levels (1: a direct solve)
   int max_attempts = 3;       ///< failed attempts allowed before the job stays failed
+  /// Levels run before the job waits for promotion (a coarse-first sweep); empty: all.
+  std::optional<int> preview_levels = std::nullopt;
 };
 
 /// Where and with what a job ran (its latest attempt).
@@ -72,6 +80,13 @@ struct Job {
   std::string error;  ///< the latest failure's message; empty if none (cleared when done)
   Provenance provenance;
   double created_at = 0;
+  /// Levels of its preview, when a coarse-first sweep listed it; empty: it runs every level.
+  std::optional<int> preview_levels;
+  /// Promoted past its preview (by its sweep's rule or by hand).
+  bool promoted = false;
+
+  /// The levels this job runs before it stops: its preview, unless promoted, else all.
+  int levels_to_run() const { return preview_levels && !promoted ? *preview_levels : depth; }
 };
 
 /// Who claims: a worker's id (unique among live workers, e.g. host:pid), its host and the
@@ -108,6 +123,8 @@ struct LevelRecord {
   /// What the refinement into this level did, by name (engine/progressive/
   /// refinement_statistics.hpp); empty at level 0 and for a direct solve.
   std::map<std::string, double> refinement;
+  /// What the finished level computed, by name (db::kLevelOutputs); empty unless done.
+  std::map<std::string, double> outputs;
   std::string checkpoint_path;            ///< empty if none
   std::string checkpoint_checksum;        ///< of the checkpoint file; empty if none
   std::string error;                      ///< empty unless failed
@@ -121,6 +138,13 @@ struct SweepAddition {
   std::int64_t already_present = 0;
 };
 
+/// What a selection of previewed points did.
+struct Promotion {
+  std::int64_t candidates = 0;        ///< points with a preview the rule judged
+  std::vector<std::string> selected;  ///< ids the rule selected, in job order
+  std::vector<std::string> promoted;  ///< of those, the ones that were waiting at preview
+};
+
 /// Job counts of one sweep.
 struct SweepStatus {
   std::string name;
@@ -128,6 +152,7 @@ struct SweepStatus {
   double created_at = 0;
   std::map<JobState, std::int64_t> counts;  ///< every state present, zeros included
   std::int64_t expired_leases = 0;  ///< running jobs whose worker stopped heartbeating
+  RefineRule refine;                ///< what follows the previews (RefineKind::all: none)
   std::int64_t total() const;
 };
 

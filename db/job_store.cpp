@@ -64,7 +64,8 @@ constexpr const char* kBackToTheQueue = "state = 'queued', lease_owner = NULL, l
 constexpr const char* kJobColumns =
     "jobs.id, jobs.parameters, jobs.scene, jobs.depth, jobs.state, jobs.attempt, jobs.failures, "
     "jobs.max_attempts, jobs.lease_owner, jobs.lease_expiry, jobs.heartbeat_at, jobs.error, "
-    "jobs.code_version, jobs.host, jobs.started_at, jobs.ended_at, jobs.created_at";
+    "jobs.code_version, jobs.host, jobs.started_at, jobs.ended_at, jobs.created_at, "
+    "jobs.preview_levels, jobs.promoted";
 
 Job read_job(const Statement& row) {
   Job job;
@@ -82,12 +83,14 @@ Job read_job(const Statement& row) {
   job.error = row.text(11);
   job.provenance = {row.text(12), row.text(13), row.optional_real(14), row.optional_real(15)};
   job.created_at = row.real(16);
+  if (!row.is_null(17)) job.preview_levels = static_cast<int>(row.integer(17));
+  job.promoted = row.integer(18) != 0;
   return job;
 }
 
 constexpr const char* kLevelColumns =
     "level, status, iterations, residuals, timings, checkpoint_path, checkpoint_checksum, "
-    "error, attempt, updated_at, static_residuals, refinement";
+    "error, attempt, updated_at, static_residuals, refinement, outputs";
 
 /// A stored number: JSON has no NaN or infinity, nlohmann writes them as null, read back as NaN.
 double stored_number(const nlohmann::json& value) {
@@ -127,6 +130,7 @@ LevelRecord read_level(const Statement& row, int first) {
   for (const auto& frame : nlohmann::json::parse(row.text(first + 10)))
     level.static_residuals.emplace_back(frame.at(0).get<int>(), stored_number(frame.at(1)));
   level.refinement = stored_named_numbers(row.text(first + 11));
+  level.outputs = stored_named_numbers(row.text(first + 12));
   return level;
 }
 
@@ -181,33 +185,44 @@ double JobStore::now() const {
 }
 
 SweepAddition JobStore::add_sweep(const std::string& name, const std::string& source,
-                                  const std::vector<NewJob>& jobs) {
-  return add_jobs(name, source, jobs, true);
+                                  const std::vector<NewJob>& jobs, const RefineRule& refine) {
+  return add_jobs(name, source, jobs, refine, true);
 }
 
 SweepAddition JobStore::preview_sweep(const std::string& name, const std::vector<NewJob>& jobs) {
   // The same code as add_sweep, rolled back: the preview cannot disagree with the real thing.
-  return add_jobs(name, "", jobs, false);
+  return add_jobs(name, "", jobs, {}, false);
 }
 
 SweepAddition JobStore::add_jobs(const std::string& name, const std::string& source,
-                                 const std::vector<NewJob>& jobs, bool commit) {
+                                 const std::vector<NewJob>& jobs, const RefineRule& refine,
+                                 bool commit) {
   if (name.empty()) throw InputError("a sweep needs a non-empty name");
   for (const auto& job : jobs) validate_new_job(name, job);
   Transaction transaction(connection_, Transaction::Mode::immediate);
   const double time = now();
   std::int64_t sweep_id = 0;
   {
+    // A selecting rule is armed: it is applied once the sweep's previews are in, which may be
+    // at the next claim if they already are.
     auto upsert = connection_.prepare(
-        "INSERT INTO sweeps (name, source, created_at) VALUES (?1, ?2, ?3) "
-        "ON CONFLICT (name) DO UPDATE SET source = excluded.source RETURNING id");
-    upsert.bind_all(name, source, time).step();
+        "INSERT INTO sweeps (name, source, created_at, refine, refine_pending) "
+        "VALUES (?1, ?2, ?3, ?4, ?5) ON CONFLICT (name) DO UPDATE SET source = excluded.source, "
+        "refine = excluded.refine, refine_pending = excluded.refine_pending RETURNING id");
+    upsert.bind_all(name, source, time, to_json(refine).dump(), int{refine.selects()}).step();
     sweep_id = upsert.integer(0);
   }
   auto stored = connection_.prepare("SELECT parameters FROM jobs WHERE id = ?1");
   auto insert = connection_.prepare(
-      "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at) "
-      "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+      "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at, preview_levels) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
+  // A job listed again keeps the most levels any sweep asks of it: none stops it earlier, and
+  // one that wants more (all of them: NULL) sends a waiting preview back to the queue.
+  auto widen = connection_.prepare(
+      "UPDATE jobs SET preview_levels = CASE WHEN ?2 IS NULL THEN NULL "
+      "ELSE MAX(preview_levels, ?2) END, state = CASE WHEN state = 'previewed' AND "
+      "(?2 IS NULL OR ?2 > preview_levels) THEN 'queued' ELSE state END "
+      "WHERE id = ?1 AND preview_levels IS NOT NULL AND promoted = 0");
   auto link =
       connection_.prepare("INSERT OR IGNORE INTO sweep_jobs (sweep_id, job_id) VALUES (?1, ?2)");
   SweepAddition addition;
@@ -220,8 +235,10 @@ SweepAddition JobStore::add_jobs(const std::string& name, const std::string& sou
             "job ids must be hashes of the canonical parameters",
             name, job.id, stored.text(0), parameters));
       ++addition.already_present;
+      widen.reset().bind_all(job.id, job.preview_levels).run();
     } else {
-      insert.reset().bind_all(job.id, parameters, job.scene, job.depth, job.max_attempts, time);
+      insert.reset().bind_all(job.id, parameters, job.scene, job.depth, job.max_attempts, time,
+                              job.preview_levels);
       insert.run();
       addition.added.push_back(job.id);
     }
@@ -276,6 +293,7 @@ std::optional<Claim> JobStore::claim_next(const WorkerInfo& worker, double lease
   check_selection_exists(which);
   const double time = now();
   expire_leases(time);
+  apply_settled_rules();
   std::string id;
   {
     auto next = connection_.prepare("SELECT id FROM jobs WHERE state = 'queued' AND " +
@@ -348,12 +366,13 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
       .prepare(
           "REPLACE INTO levels (job_id, level, status, iterations, residuals, timings, "
           "checkpoint_path, checkpoint_checksum, error, attempt, updated_at, static_residuals, "
-          "refinement) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)")
+          "refinement, outputs) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, "
+          "?14)")
       .bind_all(lease.job_id, level.level, to_string(level.status), level.iterations,
                 nlohmann::json(level.residuals).dump(), named_numbers_json(level.timings),
                 path, checksum, unless_empty(level.error), lease.attempt, now(),
                 nlohmann::json(level.static_residuals).dump(),
-                named_numbers_json(level.refinement))
+                named_numbers_json(level.refinement), named_numbers_json(level.outputs))
       .run();
   if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();
@@ -362,12 +381,13 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
 void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& error) {
   Transaction transaction(connection_, Transaction::Mode::immediate);
   check_lease(lease);
-  if (outcome == Outcome::done) {
+  if (outcome == Outcome::done || outcome == Outcome::previewed) {
     connection_
         .prepare(
-            "UPDATE jobs SET state = 'done', error = NULL, lease_owner = NULL, "
+            "UPDATE jobs SET state = ?3, error = NULL, lease_owner = NULL, "
             "lease_expiry = NULL, ended_at = ?2 WHERE id = ?1")
-        .bind_all(lease.job_id, now())
+        .bind_all(lease.job_id, now(),
+                  to_string(outcome == Outcome::done ? JobState::done : JobState::previewed))
         .run();
   } else {
     const int permanent = outcome == Outcome::failed_permanently;
@@ -379,6 +399,17 @@ void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& er
         .bind_all(lease.job_id, now(), unless_empty(error), permanent)
         .run();
   }
+  if (outcome == Outcome::previewed)
+    connection_
+        .prepare(
+            "UPDATE sweeps SET refine_pending = 1 WHERE id IN "
+            "(SELECT sweep_id FROM sweep_jobs WHERE job_id = ?1)")
+        .bind_all(lease.job_id)
+        .run();
+  // In the same transaction as the job's end, so that the last preview of a sweep (or its last
+  // failure) and the promotion it triggers are one step that a killed worker cannot split.
+  apply_settled_rules();
+  if (options_.inside_finish_transaction) options_.inside_finish_transaction();
   transaction.commit();
 }
 
@@ -440,10 +471,89 @@ std::int64_t JobStore::retry(const JobSelection& which, bool include_cancelled) 
           states);
 }
 
+std::vector<PreviewPoint> JobStore::preview_points(std::int64_t sweep_id) {
+  // Every job of the sweep that has its preview: waiting at it, or promoted past it. The last
+  // preview level's outputs, and the one before it for rules on the change between the two.
+  auto rows = connection_.prepare(
+      "SELECT jobs.id, jobs.parameters, jobs.preview_levels, levels.level, levels.outputs, "
+      "jobs.depth "
+      "FROM jobs JOIN sweep_jobs ON sweep_jobs.job_id = jobs.id "
+      "JOIN levels ON levels.job_id = jobs.id AND levels.status = 'done' "
+      "AND levels.level >= jobs.preview_levels - 2 AND levels.level < jobs.preview_levels "
+      "WHERE sweep_jobs.sweep_id = ?1 AND jobs.preview_levels IS NOT NULL "
+      "AND (jobs.state = 'previewed' OR jobs.promoted = 1) ORDER BY jobs.number, levels.level");
+  rows.bind_all(sweep_id);
+  std::vector<PreviewPoint> points;
+  while (rows.step()) {
+    if (points.empty() || points.back().job_id != rows.text(0)) {
+      PreviewPoint& point = points.emplace_back();
+      point.job_id = rows.text(0);
+      const nlohmann::json parameters = nlohmann::json::parse(rows.text(1));
+      point.parameters["depth"] = static_cast<double>(rows.integer(5));
+      const nlohmann::json overrides = parameters.value("overrides", nlohmann::json::object());
+      for (const auto& [path, value] : overrides.items())
+        if (value.is_number()) point.parameters[path] = value.get<double>();
+    }
+    const bool last = rows.integer(3) == rows.integer(2) - 1;
+    (last ? points.back().outputs : points.back().earlier_outputs) =
+        stored_named_numbers(rows.text(4));
+  }
+  // A job whose last preview level is not recorded as done has no preview to judge.
+  std::erase_if(points, [](const PreviewPoint& point) { return point.outputs.empty(); });
+  return points;
+}
+
+Promotion JobStore::promote_in_transaction(std::int64_t sweep_id, const RefineRule& rule) {
+  const std::vector<PreviewPoint> points = preview_points(sweep_id);
+  Promotion promotion;
+  promotion.candidates = static_cast<std::int64_t>(points.size());
+  promotion.selected = select_points(rule, points);
+  auto promote = connection_.prepare(
+      "UPDATE jobs SET state = 'queued', promoted = 1, ended_at = NULL "
+      "WHERE id = ?1 AND state = 'previewed'");
+  for (const std::string& id : promotion.selected)
+    if (promote.reset().bind_all(id).run() == 1) promotion.promoted.push_back(id);
+  return promotion;
+}
+
+void JobStore::apply_settled_rules() {
+  struct Pending {
+    std::int64_t id;
+    std::string refine;
+  };
+  std::vector<Pending> settled;
+  {
+    auto rows = connection_.prepare(
+        "SELECT sweeps.id, sweeps.refine FROM sweeps WHERE refine_pending = 1 AND NOT EXISTS "
+        "(SELECT 1 FROM sweep_jobs JOIN jobs ON jobs.id = sweep_jobs.job_id "
+        "WHERE sweep_jobs.sweep_id = sweeps.id AND jobs.preview_levels IS NOT NULL "
+        "AND jobs.promoted = 0 AND jobs.state IN ('queued', 'running'))");
+    while (rows.step()) settled.push_back({rows.integer(0), rows.text(1)});
+  }
+  auto applied = connection_.prepare("UPDATE sweeps SET refine_pending = 0 WHERE id = ?1");
+  for (const Pending& sweep : settled) {
+    const RefineRule rule = refine_rule_from_json(nlohmann::json::parse(sweep.refine));
+    if (rule.selects()) promote_in_transaction(sweep.id, rule);
+    applied.reset().bind_all(sweep.id).run();
+  }
+}
+
+Promotion JobStore::promote(const std::string& sweep, const RefineRule& rule) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_selection_exists(JobSelection::sweep(sweep));
+  auto found = connection_.prepare("SELECT id FROM sweeps WHERE name = ?1");
+  found.bind_all(sweep).step();
+  const std::int64_t sweep_id = found.integer(0);
+  found.reset();
+  Promotion promotion = promote_in_transaction(sweep_id, rule);
+  transaction.commit();
+  return promotion;
+}
+
 std::vector<SweepStatus> JobStore::status() {
   auto rows = connection_.prepare(
       "SELECT sweeps.name, sweeps.source, sweeps.created_at, jobs.state, COUNT(jobs.id), "
-      "COALESCE(SUM(jobs.state = 'running' AND jobs.lease_expiry <= ?1), 0) "
+      "COALESCE(SUM(jobs.state = 'running' AND jobs.lease_expiry <= ?1), 0), sweeps.refine "
       "FROM sweeps LEFT JOIN sweep_jobs ON sweep_jobs.sweep_id = sweeps.id "
       "LEFT JOIN jobs ON jobs.id = sweep_jobs.job_id "
       "GROUP BY sweeps.id, jobs.state ORDER BY sweeps.id");
@@ -455,6 +565,7 @@ std::vector<SweepStatus> JobStore::status() {
       sweep.name = rows.text(0);
       sweep.source = rows.text(1);
       sweep.created_at = rows.real(2);
+      sweep.refine = refine_rule_from_json(nlohmann::json::parse(rows.text(6)));
       for (const JobState state : kAllJobStates) sweep.counts[state] = 0;
     }
     if (rows.is_null(3)) continue;  // a sweep without jobs

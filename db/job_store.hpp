@@ -35,6 +35,9 @@ struct JobStoreOptions {
   /// Test seam: called inside record_level's transaction, after the row is written and before
   /// the commit (to kill a process in the middle of a database write).
   std::function<void()> inside_record_transaction;
+  /// Test seam: called inside finish's transaction, after the job's end and any promotion it
+  /// triggers are written and before the commit.
+  std::function<void()> inside_finish_transaction;
 };
 
 /// One connection to a job store. Not thread-safe: use one JobStore per thread (e.g. a second
@@ -50,12 +53,22 @@ class JobStore {
   const std::filesystem::path& path() const { return connection_.path(); }
 
   /// Adds the sweep `name` (or extends it) with the jobs whose ids are not yet stored; jobs
-  /// already stored (by this or another sweep) are only linked to it and keep their state.
-  /// Throws InputError if a job is invalid or an id is stored with other parameters.
+  /// already stored (by this or another sweep) are only linked to it and keep their state,
+  /// except that a job keeps the most levels any of its sweeps asks of it (a previewed job
+  /// linked to a sweep that wants more goes back to the queue). `refine` (the sweep's, stored
+  /// with it and replacing an earlier one) is applied once the previews are in. Throws
+  /// InputError if a job is invalid or an id is stored with other parameters.
   SweepAddition add_sweep(const std::string& name, const std::string& source,
-                          const std::vector<NewJob>& jobs);
+                          const std::vector<NewJob>& jobs, const RefineRule& refine = {});
   /// What add_sweep would do, without changing anything.
   SweepAddition preview_sweep(const std::string& name, const std::vector<NewJob>& jobs);
+
+  /// Promotes the previewed jobs of `sweep` that `rule` selects: they go back to the queue and
+  /// then run their finer levels, resuming from their preview checkpoints. The rule judges
+  /// every job of the sweep that has a preview (promoted ones too, so that a ranking means the
+  /// same whenever it is applied). One write transaction: two processes never promote a job
+  /// twice. Throws InputError for an unknown sweep or a condition naming nothing the jobs have.
+  Promotion promote(const std::string& sweep, const RefineRule& rule);
 
   /// Claims the first queued job (in the order jobs were added) for `worker`, with a lease of
   /// `lease_seconds`. Running jobs whose lease expired are first put back in the queue: with
@@ -108,8 +121,16 @@ class JobStore {
 
  private:
   SweepAddition add_jobs(const std::string& name, const std::string& source,
-                         const std::vector<NewJob>& jobs, bool commit);
+                         const std::vector<NewJob>& jobs, const RefineRule& refine, bool commit);
   void expire_leases(double time);
+  /// Applies the rule of every sweep whose previews have come in since its rule was last
+  /// applied, once none of its jobs is still queued or running towards its preview. Inside the
+  /// caller's write transaction.
+  void apply_settled_rules();
+  /// In the caller's write transaction: the selection of `rule` among the previews of the
+  /// sweep `sweep_id`, and those promoted.
+  Promotion promote_in_transaction(std::int64_t sweep_id, const RefineRule& rule);
+  std::vector<PreviewPoint> preview_points(std::int64_t sweep_id);
   /// Throws LeaseLostError unless the job is running with the lease's attempt; returns its
   /// depth.
   int check_lease(const Lease& lease);

@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <sqlite3.h>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,8 @@ struct Migration {
   int version;
   const char* description;
   const char* sql;
+  /// Drops and recreates a table others refer to: must run with foreign keys off.
+  bool rebuilds_tables = false;
 };
 
 // Times are REAL seconds since the Unix epoch (sub-second, comparable across processes).
@@ -116,6 +120,57 @@ constexpr const char* kRefinementStatistics = R"sql(
 ALTER TABLE levels ADD COLUMN refinement TEXT NOT NULL DEFAULT '{}';
 )sql";
 
+// Coarse-first sweeps (docs/sweep-format.md): a job may stop at its preview levels in the new
+// state 'previewed' until it is promoted. SQLite cannot alter a CHECK constraint, so `jobs` is
+// rebuilt (SQLite's documented twelve-step procedure, run with foreign keys off so that dropping
+// the old table does not cascade into sweep_jobs and levels). Each finished level records its
+// outputs, by which a sweep's rule (sweeps.refine) selects; refine_pending is set when a preview
+// finishes and cleared once the rule has been applied to the settled previews.
+constexpr const char* kCoarseFirst = R"sql(
+CREATE TABLE jobs_with_previews (
+  number           INTEGER PRIMARY KEY,
+  id               TEXT NOT NULL UNIQUE,
+  parameters       TEXT NOT NULL,
+  scene            TEXT NOT NULL,
+  depth            INTEGER NOT NULL CHECK (depth >= 1),
+  state            TEXT NOT NULL DEFAULT 'queued'
+                   CHECK (state IN ('queued', 'running', 'done', 'failed', 'cancelled',
+                                    'previewed')),
+  attempt          INTEGER NOT NULL DEFAULT 0 CHECK (attempt >= 0),
+  failures         INTEGER NOT NULL DEFAULT 0 CHECK (failures >= 0),
+  max_attempts     INTEGER NOT NULL CHECK (max_attempts >= 1),
+  lease_owner      TEXT,
+  lease_expiry     REAL,
+  heartbeat_at     REAL,
+  error            TEXT,
+  code_version     TEXT,
+  host             TEXT,
+  started_at       REAL,
+  ended_at         REAL,
+  created_at       REAL NOT NULL,
+  progress_attempt INTEGER,
+  stalls           INTEGER NOT NULL DEFAULT 0 CHECK (stalls >= 0),
+  preview_levels   INTEGER CHECK (preview_levels IS NULL OR
+                                  (preview_levels >= 1 AND preview_levels < depth)),
+  promoted         INTEGER NOT NULL DEFAULT 0 CHECK (promoted IN (0, 1)),
+  CHECK ((state = 'running') = (lease_owner IS NOT NULL)),
+  CHECK ((state = 'running') = (lease_expiry IS NOT NULL))
+);
+INSERT INTO jobs_with_previews (number, id, parameters, scene, depth, state, attempt, failures,
+  max_attempts, lease_owner, lease_expiry, heartbeat_at, error, code_version, host, started_at,
+  ended_at, created_at, progress_attempt, stalls)
+SELECT number, id, parameters, scene, depth, state, attempt, failures, max_attempts, lease_owner,
+  lease_expiry, heartbeat_at, error, code_version, host, started_at, ended_at, created_at,
+  progress_attempt, stalls FROM jobs;
+DROP TABLE jobs;
+ALTER TABLE jobs_with_previews RENAME TO jobs;
+CREATE INDEX jobs_by_state ON jobs (state, number);
+CREATE INDEX running_jobs_by_lease_expiry ON jobs (lease_expiry) WHERE state = 'running';
+ALTER TABLE levels ADD COLUMN outputs TEXT NOT NULL DEFAULT '{}';
+ALTER TABLE sweeps ADD COLUMN refine TEXT NOT NULL DEFAULT '{"kind":"all"}';
+ALTER TABLE sweeps ADD COLUMN refine_pending INTEGER NOT NULL DEFAULT 0;
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
@@ -123,6 +178,8 @@ constexpr std::array kMigrations{
     Migration{3, "SLURM array tasks holding jobs", kSlurmTasks},
     Migration{4, "progress-aware retries: progress_attempt, stalls", kProgressAwareRetries},
     Migration{5, "refinement statistics of each level", kRefinementStatistics},
+    Migration{6, "coarse-first sweeps: previewed jobs, level outputs, refine rules", kCoarseFirst,
+              true},
 };
 
 constexpr const char* kVersionTable = R"sql(
@@ -165,6 +222,57 @@ void check_compatible(SqliteConnection& connection, int version) {
   }
 }
 
+/// Foreign keys off while it lives. SQLite ignores the pragma inside a transaction, so this
+/// wraps the migration's transaction, not the other way round.
+class ForeignKeysOff {
+ public:
+  explicit ForeignKeysOff(SqliteConnection& connection) : connection_(connection) {
+    connection_.execute("PRAGMA foreign_keys = OFF");
+  }
+  ~ForeignKeysOff() {
+    try {
+      connection_.execute("PRAGMA foreign_keys = ON");
+    } catch (...) {
+      // The connection is then unusable anyway; its next statement reports why.
+    }
+  }
+  ForeignKeysOff(const ForeignKeysOff&) = delete;
+  ForeignKeysOff& operator=(const ForeignKeysOff&) = delete;
+
+ private:
+  SqliteConnection& connection_;
+};
+
+/// A rebuilt table must leave every reference to it whole; otherwise the migration is rolled
+/// back.
+void check_foreign_keys(SqliteConnection& connection) {
+  auto problems = connection.prepare("PRAGMA foreign_key_check");
+  if (problems.step())
+    throw DatabaseError(fmt::format("{}: a migration left row {} of {} referring to a missing "
+                                    "row of {}; it was rolled back",
+                                    connection.path().string(), problems.integer(1),
+                                    problems.text(0), problems.text(2)),
+                        SQLITE_CONSTRAINT_FOREIGNKEY);
+}
+
+/// Applies `migration` in its own write transaction unless another process already has.
+void apply(SqliteConnection& connection, const Migration& migration) {
+  std::optional<ForeignKeysOff> foreign_keys_off;
+  if (migration.rebuilds_tables) foreign_keys_off.emplace(connection);
+  Transaction write(connection, Transaction::Mode::immediate);
+  // Read again under the write lock: another process may have migrated meanwhile.
+  const int version = schema_version(connection);
+  check_compatible(connection, version);
+  if (version >= migration.version) return;
+  connection.execute(kVersionTable);
+  connection.execute(migration.sql);
+  if (migration.rebuilds_tables) check_foreign_keys(connection);
+  connection.prepare("INSERT INTO schema_version (version, description) VALUES (?, ?)")
+      .bind_all(migration.version, migration.description)
+      .run();
+  write.commit();
+}
+
 }  // namespace
 
 int latest_schema_version() { return kMigrations.back().version; }
@@ -184,19 +292,7 @@ void migrate(SqliteConnection& connection) {
     check_compatible(connection, version);
     if (version == latest_schema_version()) return;
   }
-  for (const auto& migration : kMigrations) {
-    Transaction write(connection, Transaction::Mode::immediate);
-    // Read again under the write lock: another process may have migrated meanwhile.
-    const int version = schema_version(connection);
-    check_compatible(connection, version);
-    if (version >= migration.version) continue;
-    connection.execute(kVersionTable);
-    connection.execute(migration.sql);
-    connection.prepare("INSERT INTO schema_version (version, description) VALUES (?, ?)")
-        .bind_all(migration.version, migration.description)
-        .run();
-    write.commit();
-  }
+  for (const auto& migration : kMigrations) apply(connection, migration);
 }
 
 }  // namespace psq::db

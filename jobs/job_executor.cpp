@@ -146,6 +146,7 @@ class JobRun {
       while (true) {
         if (!solver_->level_done()) solve_level();  // a resumed level may be done already
         if (solver_->finished()) break;
+        if (solver_->level() + 1 >= claim_.job.levels_to_run()) return finish_preview();
         refine();
         start_level();
       }
@@ -431,6 +432,7 @@ class JobRun {
       level.residuals.push_back(it.gradient_norm);
     level.timings = statistics_.timings;
     level.refinement = statistics_.refinement;
+    if (status == db::LevelStatus::done) level.outputs = level_outputs();
     if (solver_) level.static_residuals = static_residuals(statistics_.iterations, *solver_);
     if (!file.empty()) {
       level.checkpoint_path = fs::absolute(file).lexically_normal().string();
@@ -440,6 +442,20 @@ class JobRun {
     test_point("record_level");
     through_store([&] { store_.record_level(claim_.lease, level); });
     statistics_.timings["database"] += seconds_since(start);
+  }
+
+  /// What the finished level computed (db::kLevelOutputs), by which coarse-first rules select.
+  std::map<std::string, double> level_outputs() const {
+    const Positions& rest = solver_->level_rest_mesh().vertices;
+    const Positions positions = as_positions(solver_->positions());
+    std::map<std::string, double> outputs{
+        {"max_displacement", (positions - rest).rowwise().norm().maxCoeff()},
+        {"iterations", static_cast<double>(steps_taken())},
+        {"seconds", statistics_.timings.count("wall") ? statistics_.timings.at("wall") : 0.0}};
+    if (frame_energy_) outputs["elastic_energy"] = *frame_energy_;
+    if (!statistics_.iterations.empty())
+      outputs["residual"] = statistics_.iterations.back().gradient_norm;
+    return outputs;
   }
 
   std::int64_t steps_taken() const {
@@ -474,6 +490,16 @@ class JobRun {
   }
 
   // ---- endings -------------------------------------------------------------------------------
+
+  /// A coarse-first job has run its preview levels: it stops there until promoted, and then
+  /// resumes from the last preview level's checkpoint and refines as if it had not stopped.
+  RunOutcome finish_preview() {
+    test_point("before_finish");
+    through_store([&] { store_.finish(claim_.lease, db::Outcome::previewed); });
+    log(fmt::format("previewed (levels 0–{}) in {:.1f} s; the finer levels wait for promotion",
+                    solver_->level(), seconds_since(run_start_)));
+    return RunOutcome::previewed;
+  }
 
   RunOutcome fail(db::Outcome outcome, const std::string& message) {
     try {

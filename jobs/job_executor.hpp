@@ -51,6 +51,7 @@ struct ExecutorEvents {
 /// How a run of a job ended.
 enum class RunOutcome {
   done,         ///< every level recorded, the job finished
+  previewed,    ///< its preview levels recorded; it waits for promotion (a coarse-first sweep)
   failed,       ///< the job is marked failed (retried later if attempts remain and useful)
   interrupted,  ///< a stop was requested: snapshot written, claim released
   lease_lost,   ///< cancelled or reclaimed meanwhile: stopped without writing anything more

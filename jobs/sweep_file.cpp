@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <set>
@@ -21,6 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kDepth = "depth";
+const std::string kRefine = "refine";
 /// A job's levels are its depth, which replaces the scene's [hierarchy] levels.
 const std::string kSceneLevels = "hierarchy.levels";
 
@@ -52,12 +54,13 @@ class SweepReader {
       : file_(std::move(file)), document_(parse(text)) {}
 
   Sweep read() {
-    allow_only(document_, {"name", "scene", kDepth, "grid", "zip"}, "at the top level");
+    allow_only(document_, {"name", "scene", kDepth, "grid", "zip", kRefine}, "at the top level");
     Sweep sweep;
     sweep.file = file_;
     sweep.name = required_string("name");
     sweep.scene = scene_path();
     sweep.scene_hash = file_content_hash(sweep.scene);
+    sweep.refine = read_refine();
     const SceneDocument base = SceneDocument::read(sweep.scene);
     const std::vector<Axis> axes = read_axes(base);
     check_job_count(axes);
@@ -71,6 +74,7 @@ class SweepReader {
                             it->second + 1, sweep.jobs.size() + 1, describe_parameters(job)));
       sweep.jobs.push_back(std::move(job));
     });
+    check_refine_depths(sweep);
     return sweep;
   }
 
@@ -307,6 +311,193 @@ class SweepReader {
     return job;
   }
 
+  // ---- refine: coarse-first sweeps ------------------------------------------------------------
+
+  /// The top-level `refine`: "all" (the default), "none", or a table naming a rule.
+  db::RefineRule read_refine() const {
+    const toml::node* node = document_.get(kRefine);
+    if (!node) return {};
+    if (const auto* text = node->as_string()) {
+      if (text->get() == "all") return {};
+      if (text->get() == "none") return rule_of_kind(db::RefineKind::none);
+      fail(line_of(*node), fmt::format("'refine' = \"{}\" is not a choice; use \"all\", \"none\" "
+                                       "or a table with a rule: refine = {{ rule = \"top\", by = "
+                                       "\"max_displacement\", count = 3 }}",
+                                       text->get()));
+    }
+    const toml::table* table = node->as_table();
+    if (!table)
+      fail(line_of(*node), "'refine' must be \"all\", \"none\" or a table with a rule");
+    return read_refine_rule(*table, line_of(*node));
+  }
+
+  db::RefineRule read_refine_rule(const toml::table& table, long line) const {
+    static const std::map<std::string, std::pair<db::RefineKind, std::vector<std::string>>> rules{
+        {"none", {db::RefineKind::none, {}}},
+        {"top", {db::RefineKind::top, {"by", "count", "order"}}},
+        {"threshold", {db::RefineKind::threshold, {"by", "above", "below"}}},
+        {"pareto", {db::RefineKind::pareto, {"minimize", "maximize"}}},
+        {"changed", {db::RefineKind::changed, {"by", "count", "above"}}},
+    };
+    const toml::node* name = table.get("rule");
+    std::vector<std::string> names;
+    for (const auto& [rule, kind] : rules) names.push_back(rule);
+    if (!name || !name->is_string())
+      fail(name ? line_of(*name) : line,
+           fmt::format("'rule' in 'refine' must name a rule: {}", fmt::join(names, ", ")));
+    const std::string given = *name->value<std::string>();
+    const auto rule = rules.find(given);
+    if (rule == rules.end()) {
+      const auto nearest = suggest_key(given, names);
+      fail(line_of(*name), fmt::format("unknown rule '{}' in 'refine'{}; valid rules: {}", given,
+                                       nearest ? fmt::format(" (did you mean '{}'?)", *nearest) : "",
+                                       fmt::join(names, ", ")));
+    }
+    std::vector<std::string> allowed = rule->second.second;
+    allowed.insert(allowed.end(), {"rule", "preview"});
+    allow_only(table, allowed, fmt::format("in 'refine' with rule = \"{}\"", given));
+    db::RefineRule refine = rule_of_kind(rule->second.first);
+    if (const toml::node* preview = table.get("preview"))
+      refine.preview = positive_integer(*preview, "preview");
+    switch (refine.kind) {
+      case db::RefineKind::top:
+        refine.by = required_output(table, "by", line);
+        refine.count = positive_integer(required(table, "count", line), "count");
+        refine.preference = read_order(table);
+        break;
+      case db::RefineKind::threshold:
+        refine.by = required_output(table, "by", line);
+        read_bound(table, "above", db::Comparison::greater, refine);
+        read_bound(table, "below", db::Comparison::less, refine);
+        if (refine.conditions.empty())
+          fail(line, "'refine' with rule = \"threshold\" needs 'above', 'below' or both");
+        break;
+      case db::RefineKind::pareto:
+        read_objectives(table, line, refine);
+        break;
+      case db::RefineKind::changed:
+        refine.by = required_output(table, "by", line);
+        if (table.get("count") && table.get("above"))
+          fail(line, "'refine' with rule = \"changed\" takes 'count' or 'above', not both");
+        if (const toml::node* count = table.get("count"))
+          refine.count = positive_integer(*count, "count");
+        else if (const toml::node* above = table.get("above"))
+          refine.change_above = number(*above, "above");
+        else
+          fail(line, "'refine' with rule = \"changed\" needs 'count' (how many points) or "
+                     "'above' (a relative change, e.g. 0.05)");
+        break;
+      default:
+        break;
+    }
+    return refine;
+  }
+
+  static db::RefineRule rule_of_kind(db::RefineKind kind) {
+    db::RefineRule rule;
+    rule.kind = kind;
+    return rule;
+  }
+
+  const toml::node& required(const toml::table& table, const std::string& key, long line) const {
+    const toml::node* node = table.get(key);
+    if (!node) fail(line, fmt::format("'refine' with this rule needs '{}'", key));
+    return *node;
+  }
+
+  int positive_integer(const toml::node& node, const std::string& key) const {
+    const auto* integer = node.as_integer();
+    if (!integer || integer->get() < 1 || integer->get() > 64'000)
+      fail(line_of(node), fmt::format("'{}' in 'refine' must be a positive integer", key));
+    return static_cast<int>(integer->get());
+  }
+
+  double number(const toml::node& node, const std::string& key) const {
+    if (const auto* integer = node.as_integer()) return static_cast<double>(integer->get());
+    if (const auto* real = node.as_floating_point(); real && std::isfinite(real->get()))
+      return real->get();
+    fail(line_of(node), fmt::format("'{}' in 'refine' must be a number", key));
+  }
+
+  /// An output name, checked against what jobs record (db::kLevelOutputs).
+  std::string output_name(const toml::node& node, const std::string& key) const {
+    const std::vector<std::string> outputs(db::kLevelOutputs.begin(), db::kLevelOutputs.end());
+    const auto name = node.value<std::string>();
+    if (!node.is_string() || std::find(outputs.begin(), outputs.end(), *name) == outputs.end()) {
+      const auto nearest = name ? suggest_key(*name, outputs) : std::nullopt;
+      fail(line_of(node), fmt::format("'{}' in 'refine' must name an output a job records{}; "
+                                      "valid outputs: {}",
+                                      key,
+                                      nearest ? fmt::format(" (did you mean '{}'?)", *nearest) : "",
+                                      fmt::join(outputs, ", ")));
+    }
+    return *name;
+  }
+
+  std::string required_output(const toml::table& table, const std::string& key, long line) const {
+    return output_name(required(table, key, line), key);
+  }
+
+  db::Preference read_order(const toml::table& table) const {
+    const toml::node* order = table.get("order");
+    if (!order) return db::Preference::largest;
+    const auto text = order->value<std::string>();
+    if (text == "largest") return db::Preference::largest;
+    if (text == "smallest") return db::Preference::smallest;
+    fail(line_of(*order), "'order' in 'refine' must be \"largest\" or \"smallest\"");
+  }
+
+  void read_bound(const toml::table& table, const std::string& key, db::Comparison op,
+                  db::RefineRule& refine) const {
+    if (const toml::node* bound = table.get(key))
+      refine.conditions.push_back({refine.by, op, number(*bound, key)});
+  }
+
+  /// `minimize` and `maximize`: lists of outputs, two in all.
+  void read_objectives(const toml::table& table, long line, db::RefineRule& refine) const {
+    for (const auto& [key, preference] : {std::pair{"minimize", db::Preference::smallest},
+                                          std::pair{"maximize", db::Preference::largest}}) {
+      const toml::node* node = table.get(key);
+      if (!node) continue;
+      const toml::array* list = node->as_array();
+      if (!list)
+        fail(line_of(*node), fmt::format("'{}' in 'refine' must be a list of outputs", key));
+      for (const toml::node& output : *list)
+        refine.objectives.push_back({output_name(output, key), preference});
+    }
+    if (refine.objectives.size() != 2 ||
+        refine.objectives[0].output == refine.objectives[1].output)
+      fail(line, fmt::format("'refine' with rule = \"pareto\" needs two different outputs in "
+                             "'minimize' and 'maximize' together (got {}), e.g. minimize = "
+                             "[\"elastic_energy\"], maximize = [\"max_displacement\"]",
+                             refine.objectives.size()));
+  }
+
+  /// Every job must have levels to preview and at least one finer level to promote to; the
+  /// rule on the change between previews needs two preview levels.
+  void check_refine_depths(const Sweep& sweep) const {
+    if (!sweep.refine.previews()) return;
+    const toml::node& node = *document_.get(kRefine);
+    const toml::node* preview =
+        node.is_table() ? node.as_table()->get("preview") : nullptr;
+    for (const SweepJob& job : sweep.jobs) {
+      const int levels = sweep.refine.preview_levels(job.depth);
+      if (levels < 1 || levels >= job.depth)
+        fail(line_of(preview ? *preview : node),
+             fmt::format("job {}: a coarse-first job needs preview levels in [1, depth − 1], "
+                         "but it has depth {} and {} preview level{}; {}",
+                         describe_parameters(job), job.depth, levels, levels == 1 ? "" : "s",
+                         job.depth < 2 ? "give the sweep depth 2 or more"
+                                       : "lower 'preview' below the depth"));
+      if (sweep.refine.kind == db::RefineKind::changed && levels < 2)
+        fail(line_of(preview ? *preview : node),
+             fmt::format("job {}: rule = \"changed\" compares the last two preview levels, but "
+                         "the job has {} preview level; use depth 3 or more (and 'preview' of 2 "
+                         "or more)",
+                         describe_parameters(job), levels));
+    }
+  }
+
   fs::path file_;
   toml::table document_;
   mutable std::map<std::pair<std::string, std::string>, nlohmann::json> canonical_values_;
@@ -335,7 +526,10 @@ std::vector<db::NewJob> new_jobs(const Sweep& sweep) {
     jobs.push_back({.id = job.id,
                     .parameters = job.parameters,
                     .scene = sweep.scene.string(),
-                    .depth = job.depth});
+                    .depth = job.depth,
+                    .preview_levels = sweep.refine.previews()
+                                          ? std::optional(sweep.refine.preview_levels(job.depth))
+                                          : std::nullopt});
   return jobs;
 }
 

@@ -33,6 +33,8 @@ struct Sweep {
   /// axes come first (sorted by path, as TOML tables are unordered), then the zip groups in
   /// file order.
   std::vector<SweepJob> jobs;
+  /// What follows the previews (`refine`; docs/sweep-format.md, "Coarse-first sweeps").
+  db::RefineRule refine;
 };
 
 /// Reads and expands a sweep file; reads its scene and applies every job's overrides to it.

@@ -23,6 +23,9 @@ WorkerSummary run_worker(const std::filesystem::path& database,
       case RunOutcome::done:
         ++summary.done;
         break;
+      case RunOutcome::previewed:
+        ++summary.previewed;
+        break;
       case RunOutcome::failed:
         ++summary.failed;
         break;

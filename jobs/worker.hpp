@@ -21,6 +21,7 @@ struct WorkerOptions {
 /// How many jobs a worker ran, by outcome.
 struct WorkerSummary {
   int done = 0;
+  int previewed = 0;
   int failed = 0;
   int interrupted = 0;
   int lease_lost = 0;

@@ -163,6 +163,9 @@ std::string html_report(const SweepReport& report, Gnuplot& gnuplot) {
   plots.draw(gnuplot);
   std::string body = overview(report);
   body += "<h2>Jobs</h2>\n" + html_table(jobs_table(report));
+  if (const Table previews = preview_table(report); !previews.rows.empty())
+    body += fmt::format("<h2>Coarse-first selection</h2>\n<p>{}</p>\n{}",
+                        escape_html(db::describe(report.refine)), html_table(previews));
   body += "<h2>Levels</h2>\n" + html_table(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     body += "<h2>Refinements</h2>\n" + html_table(refinements);

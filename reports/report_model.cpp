@@ -51,6 +51,7 @@ LevelReport level_from_record(const db::LevelRecord& record) {
   if (!record.static_residuals.empty() && std::isfinite(record.static_residuals.back().second))
     level.static_residual = record.static_residuals.back().second;
   level.refinement = record.refinement;
+  level.outputs = record.outputs;
   level.checkpoint = record.checkpoint_path;
   level.error = record.error;
   return level;
@@ -156,6 +157,7 @@ SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {
   report.source = status.source;
   report.database = store.path();
   report.counts = status.counts;
+  report.refine = status.refine;
   const std::vector<db::JobResult> results = store.results(db::JobSelection::sweep(sweep));
   std::vector<std::map<std::string, nlohmann::json>> parameter_sets;
   std::set<std::string> names;

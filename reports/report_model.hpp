@@ -47,6 +47,8 @@ struct LevelReport {
   /// What the refinement into this level did, by name, as stored (engine/progressive/
   /// refinement_statistics.hpp); empty at level 0 and for a direct solve.
   std::map<std::string, double> refinement;
+  /// What the level computed, as stored (db::kLevelOutputs); empty unless done.
+  std::map<std::string, double> outputs;
   std::string checkpoint;           ///< as recorded in the store; empty if none
   std::string error;                ///< the level's failure message, if it failed
   std::optional<LevelShape> shape;  ///< only for levels of finished jobs with a readable checkpoint
@@ -79,6 +81,8 @@ struct SweepReport {
   std::string source;  ///< the sweep file
   std::filesystem::path database;
   std::map<db::JobState, std::int64_t> counts;
+  /// The sweep's coarse-first rule (RefineKind::all for an ordinary sweep).
+  db::RefineRule refine;
   std::vector<JobReport> jobs;
   /// Flattened parameter names whose value differs between jobs, sorted.
   std::vector<std::string> swept_parameters;

@@ -26,6 +26,15 @@ std::string parameter_cell(const JobReport& job, const std::string& name) {
 
 std::string state_of(const JobReport& job) { return std::string(db::to_string(job.job.state)); }
 
+/// The stored output `name` of level `level` of `job`, if recorded.
+std::optional<double> level_output(const JobReport& job, int level, const std::string& name) {
+  if (level < 0 || level >= static_cast<int>(job.levels.size())) return std::nullopt;
+  const auto& outputs = job.levels[static_cast<std::size_t>(level)].outputs;
+  const auto found = outputs.find(name);
+  if (found == outputs.end()) return std::nullopt;
+  return found->second;
+}
+
 }  // namespace
 
 std::string readable_number(std::optional<double> value) {
@@ -84,6 +93,34 @@ Table jobs_table(const SweepReport& report) {
     row.insert(row.end(), {state_of(job), readable_number(job.outputs.total_seconds),
                            readable_number(job.outputs.max_displacement),
                            readable_number(job.outputs.elastic_energy), job.job.error});
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+Table preview_table(const SweepReport& report) {
+  Table table;
+  table.header = {"#", "id"};
+  table.header.insert(table.header.end(), report.swept_parameters.begin(),
+                      report.swept_parameters.end());
+  for (const char* column : {"state", "promoted", "preview max displacement (m)",
+                             "preview elastic energy (J)", "final max displacement (m)",
+                             "final elastic energy (J)"})
+    table.header.push_back(column);
+  if (!report.refine.previews()) return table;
+  for (const JobReport& job : report.jobs) {
+    if (!job.job.preview_levels) continue;
+    const int preview = *job.job.preview_levels - 1;
+    const int finest = job.job.depth - 1;
+    std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
+    for (const std::string& name : report.swept_parameters)
+      row.push_back(parameter_cell(job, name));
+    row.insert(row.end(),
+               {state_of(job), job.job.promoted ? "yes" : "no",
+                readable_number(level_output(job, preview, "max_displacement")),
+                readable_number(level_output(job, preview, "elastic_energy")),
+                readable_number(level_output(job, finest, "max_displacement")),
+                readable_number(level_output(job, finest, "elastic_energy"))});
     table.rows.push_back(std::move(row));
   }
   return table;

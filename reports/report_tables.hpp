@@ -35,6 +35,11 @@ Table levels_table(const SweepReport& report);
 /// no level was refined (direct solves, or scenes without contact and strain limits).
 Table refinements_table(const SweepReport& report);
 
+/// A coarse-first sweep's previews and what became of them: number, short id, swept parameters,
+/// state, whether promoted, and max displacement and elastic energy of the last preview level
+/// and of the finest level. No rows for an ordinary sweep (refine = "all").
+Table preview_table(const SweepReport& report);
+
 /// RFC 4180 CSV: fields with a comma, quote or line break are quoted, quotes doubled; lines
 /// end with CRLF.
 std::string to_csv(const Table& table);

@@ -14,6 +14,9 @@ std::string summary_markdown(const SweepReport& report) {
     counts.rows.push_back({std::string(db::to_string(state)), std::to_string(count)});
   text += to_markdown(counts);
   text += "\n## Jobs\n\n" + to_markdown(jobs_table(report));
+  if (const Table previews = preview_table(report); !previews.rows.empty())
+    text += fmt::format("\n## Coarse-first selection\n\n{}\n\n{}", db::describe(report.refine),
+                        to_markdown(previews));
   text += "\n## Levels\n\n" + to_markdown(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     text += "\n## Refinements\n\n" + to_markdown(refinements);

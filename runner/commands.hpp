@@ -27,6 +27,7 @@ void register_resume_command(CLI::App& app, std::vector<Command>& commands);
 void register_results_command(CLI::App& app, std::vector<Command>& commands);
 void register_cancel_command(CLI::App& app, std::vector<Command>& commands);
 void register_retry_command(CLI::App& app, std::vector<Command>& commands);
+void register_promote_command(CLI::App& app, std::vector<Command>& commands);
 void register_report_command(CLI::App& app, std::vector<Command>& commands);
 void register_hierarchy_command(CLI::App& app, std::vector<Command>& commands);
 void register_slurm_command(CLI::App& app, std::vector<Command>& commands);

@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   psq::runner::register_results_command(app, commands);
   psq::runner::register_cancel_command(app, commands);
   psq::runner::register_retry_command(app, commands);
+  psq::runner::register_promote_command(app, commands);
   psq::runner::register_report_command(app, commands);
   psq::runner::register_hierarchy_command(app, commands);
   psq::runner::register_slurm_command(app, commands);

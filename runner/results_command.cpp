@@ -106,7 +106,8 @@ nlohmann::json to_json(const std::string& sweep, const std::vector<db::JobResult
                         {"checkpoint", level.checkpoint_path},
                         {"checkpoint_checksum", level.checkpoint_checksum},
                         {"error", level.error},
-                        {"attempt", level.attempt}});
+                        {"attempt", level.attempt},
+                        {"outputs", level.outputs}});
     }
     jobs.push_back({{"id", r.job.id},
                     {"state", db::to_string(r.job.state)},
@@ -115,10 +116,20 @@ nlohmann::json to_json(const std::string& sweep, const std::vector<db::JobResult
                     {"depth", r.job.depth},
                     {"attempt", r.job.attempt},
                     {"failures", r.job.failures},
+                    {"preview_levels", r.job.preview_levels ? nlohmann::json(*r.job.preview_levels)
+                                                             : nlohmann::json()},
+                    {"promoted", r.job.promoted},
                     {"error", r.job.error},
                     {"levels", levels}});
   }
   return {{"sweep", sweep}, {"jobs", jobs}};
+}
+
+/// How far a coarse-first job runs: "  (preview: 2 levels, promoted)"; empty for the others.
+std::string preview_note(const db::Job& job) {
+  if (!job.preview_levels) return "";
+  return fmt::format("  (preview: {} level{}{})", *job.preview_levels,
+                     *job.preview_levels == 1 ? "" : "s", job.promoted ? ", promoted" : "");
 }
 
 void print_text(const std::string& sweep, const std::vector<db::JobResult>& results) {
@@ -128,8 +139,8 @@ void print_text(const std::string& sweep, const std::vector<db::JobResult>& resu
     const nlohmann::json overrides = overrides_of(r.job);
     for (const auto& [path, value] : overrides.items())
       parameters += fmt::format(" {}={}", path, value.dump());
-    std::cout << fmt::format("{} {:<9} depth={}{}\n", r.job.id, db::to_string(r.job.state),
-                             r.job.depth, parameters);
+    std::cout << fmt::format("{} {:<9} depth={}{}{}\n", r.job.id, db::to_string(r.job.state),
+                             r.job.depth, parameters, preview_note(r.job));
     for (const db::LevelRecord& level : r.levels)
       std::cout << fmt::format("    level {} {:<7} {:>5} iterations  ‖g‖ {:.3e}  {:.2f} s{}\n",
                                level.level, db::to_string(level.status), level.iterations,

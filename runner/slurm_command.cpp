@@ -110,10 +110,18 @@ std::string array_script(const SubmitOptions& options, const fs::path& submissio
 
 std::vector<db::NewJob> queued_jobs(db::JobStore& store, const std::string& sweep) {
   std::vector<db::NewJob> jobs;
-  for (const db::JobResult& r : store.results(db::JobSelection::sweep(sweep)))
-    if (r.job.state == db::JobState::queued)
-      jobs.push_back({r.job.id, r.job.parameters, r.job.scene, r.job.depth,
-                      static_cast<int>(r.job.max_attempts)});
+  for (const db::JobResult& r : store.results(db::JobSelection::sweep(sweep))) {
+    if (r.job.state != db::JobState::queued) continue;
+    // An array task runs every level of its job; stopping at a preview is psq work's alone.
+    if (r.job.levels_to_run() < r.job.depth)
+      throw InputError(fmt::format(
+          "job {} of sweep '{}' is to stop at its preview (a coarse-first sweep), which SLURM "
+          "array tasks cannot do yet: run the previews with psq work, then submit the promoted "
+          "jobs",
+          r.job.id, sweep));
+    jobs.push_back({r.job.id, r.job.parameters, r.job.scene, r.job.depth,
+                    static_cast<int>(r.job.max_attempts), std::nullopt});
+  }
   return jobs;
 }
 

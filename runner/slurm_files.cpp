@@ -102,7 +102,7 @@ Manifest read_manifest(const fs::path& file) {
     for (const nlohmann::json& job : value.at("jobs"))
       manifest.jobs.push_back({job.at("id").get<std::string>(), job.at("parameters"),
                                job.at("scene").get<std::string>(), job.at("depth").get<int>(),
-                               job.at("max_attempts").get<int>()});
+                               job.at("max_attempts").get<int>(), std::nullopt});
     return manifest;
   } catch (const nlohmann::json::exception& error) {
     throw InputError(fmt::format("{}: a damaged SLURM manifest: {}", file.string(), error.what()));

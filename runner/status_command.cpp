@@ -66,6 +66,7 @@ nlohmann::json to_json(const std::filesystem::path& database,
                       {"total", report.status.total()},
                       {"counts", counts},
                       {"expired_leases", report.status.expired_leases},
+                      {"refine", db::to_json(report.status.refine)},
                       {"failures", failures},
                       {"slurm", cluster}});
   }
@@ -80,6 +81,8 @@ void print_text(const std::filesystem::path& database, const std::vector<SweepRe
       counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", db::to_string(state), count);
     std::cout << fmt::format("sweep '{}': {} jobs: {}\n", report.status.name, report.status.total(),
                              counts);
+    if (report.status.refine.previews())
+      std::cout << "  " << db::describe(report.status.refine) << '\n';
     if (report.status.expired_leases > 0)
       std::cout << fmt::format(
           "  {} running jobs stopped sending heartbeats (reclaimed by the "

@@ -39,6 +39,7 @@ void print_addition(const jobs::Sweep& sweep, const db::SweepAddition& addition,
                            sweep.jobs.size(), addition.added.size(),
                            dry_run ? "would be added" : "added", addition.already_present,
                            dry_run ? " (dry run: nothing written)" : "");
+  if (sweep.refine.previews()) std::cout << "  " << db::describe(sweep.refine) << '\n';
   for (const std::string& id : addition.added)
     std::cout << fmt::format("  + {}  {}\n", id, jobs::describe_parameters(*by_id.at(id)));
 }
@@ -49,7 +50,8 @@ int run_sweep_add(const SweepAddOptions& options) {
   const std::filesystem::path database = database_path(options.database);
   const db::SweepAddition addition =
       options.dry_run ? preview(database, sweep, jobs)
-                      : db::JobStore(database).add_sweep(sweep.name, sweep.file.string(), jobs);
+                      : db::JobStore(database).add_sweep(sweep.name, sweep.file.string(), jobs,
+                                                         sweep.refine);
   print_addition(sweep, addition, options.dry_run);
   return 0;
 }

@@ -90,7 +90,12 @@ int work_in_this_process(const WorkSettings& settings, const WorkerPlacement& pl
       placement.database, placement.runs, make_solver, options, events, stop_requested);
   display.clear();
   if (!supervised)
-    display.log(fmt::format("psq work: {} done, {} failed{}{}", summary.done, summary.failed,
+    display.log(fmt::format("psq work: {} done, {}{} failed{}{}", summary.done,
+                            summary.previewed
+                                ? fmt::format("{} previewed (waiting for promotion), ",
+                                              summary.previewed)
+                                : "",
+                            summary.failed,
                             summary.interrupted ? ", 1 interrupted and released" : "",
                             summary.lease_lost ? ", some stopped on a lost lease" : ""));
   return exit_code(summary.failed > 0);

@@ -517,7 +517,7 @@ TEST(JobStoreStatus, CountsEveryStatePerSweep) {
   EXPECT_EQ(sweeps[0].source, "a.toml");
   const std::map<JobState, std::int64_t> expected_a{
       {JobState::queued, 1}, {JobState::running, 1}, {JobState::done, 1},
-      {JobState::failed, 1}, {JobState::cancelled, 1}};
+      {JobState::failed, 1}, {JobState::cancelled, 1}, {JobState::previewed, 0}};
   EXPECT_EQ(sweeps[0].counts, expected_a);
   EXPECT_EQ(sweeps[1].name, "empty");
   EXPECT_EQ(sweeps[1].total(), 0);

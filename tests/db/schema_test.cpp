@@ -94,6 +94,45 @@ TEST(JobStoreSchema, NewerSchemaIsRefusedWithUpgradeAdvice) {
                                  path.string(), future, latest_schema_version()));
 }
 
+/// Drops what version 6 added, leaving what a version-5 store holds (its jobs table then
+/// lacks only the state 'previewed' in its CHECK, which the upgrade's rebuild restores anyway).
+constexpr const char* kVersionSixColumns =
+    "ALTER TABLE jobs DROP COLUMN promoted; ALTER TABLE jobs DROP COLUMN preview_levels; "
+    "ALTER TABLE levels DROP COLUMN outputs; ALTER TABLE sweeps DROP COLUMN refine; "
+    "ALTER TABLE sweeps DROP COLUMN refine_pending; ";
+
+TEST(JobStoreSchema, AVersionFiveStoreIsRebuiltKeepingJobsLevelsAndLinks) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    store.add_sweep("s", "s.toml", test::thickness_jobs(0, 3));
+    const auto claim = store.claim_next(test::worker("w"), 30);
+    LevelRecord level;
+    level.status = LevelStatus::done;
+    level.checkpoint_path = "/runs/level_0.h5";
+    level.checkpoint_checksum = "fnv1a64:0000000000000001";
+    store.record_level(claim->lease, level);
+  }
+  {
+    SqliteConnection raw(path, 1000);
+    raw.execute(std::string(kVersionSixColumns) + "DELETE FROM schema_version WHERE version > 5");
+    ASSERT_EQ(schema_version(raw), 5);
+  }
+  JobStore upgraded(path);
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  // Dropping the old jobs table must not have cascaded into the tables that refer to it.
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sweep_jobs"), 3);
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM levels"), 1);
+  EXPECT_EQ(single_integer(raw, "SELECT COUNT(*) FROM jobs WHERE state = 'running'"), 1);
+  EXPECT_TRUE(upgraded.integrity_problems().empty());
+  // The rebuilt table takes the new state.
+  raw.execute("UPDATE jobs SET state = 'previewed' WHERE state = 'queued'");
+  EXPECT_EQ(upgraded.status("s").counts.at(JobState::previewed), 2);
+  EXPECT_EQ(upgraded.results(JobSelection::all()).front().levels.front().checkpoint_path,
+            "/runs/level_0.h5");
+}
+
 TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
   const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
   {
@@ -104,6 +143,7 @@ TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
     // Back to what a store written by a version-3 psq holds.
     SqliteConnection raw(path, 1000);
     raw.execute(
+        std::string(kVersionSixColumns) +
         "ALTER TABLE jobs DROP COLUMN progress_attempt; ALTER TABLE jobs DROP COLUMN stalls; "
         "ALTER TABLE levels DROP COLUMN refinement; DELETE FROM schema_version WHERE version > 3");
     ASSERT_EQ(schema_version(raw), 3);

@@ -30,7 +30,8 @@ inline std::vector<NewJob> thickness_jobs(int first, int count, int depth = 3,
                     {{"thickness", 1e-3 * (i + 1)}, {"E", 1e6}, {"depth", depth}},
                     "jobs/scenes/sheet.toml",
                     depth,
-                    max_attempts});
+                    max_attempts,
+                    std::nullopt});
   return jobs;
 }
 

@@ -4,6 +4,7 @@
 #include "jobs/sweep_file.hpp"
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -312,6 +313,101 @@ TEST(SweepFile, TextIsReadAsIfItWereTheNamedFile) {
         << error.what();
   }
 }
+
+// ---- refine: coarse-first sweeps ------------------------------------------------------------
+
+TEST(SweepFileRefine, RulesAreReadAndJobsGetTheirPreviewLevels) {
+  const auto dir = sweep_dir();
+  const auto top = read_sweep(write_sweep(
+      dir, "depth = 3\nrefine = { rule = \"top\", by = \"max_displacement\", count = 2, "
+           "order = \"smallest\" }\n[grid]\n\"" + kH + "\" = [1e-3, 2e-3]\n"));
+  EXPECT_EQ(top.refine.kind, db::RefineKind::top);
+  EXPECT_EQ(top.refine.by, "max_displacement");
+  EXPECT_EQ(top.refine.count, 2);
+  EXPECT_EQ(top.refine.preference, db::Preference::smallest);
+  for (const db::NewJob& job : jobs::new_jobs(top)) EXPECT_EQ(job.preview_levels, 2);
+
+  const auto pareto = read_sweep(write_sweep(
+      dir, "depth = 4\n[refine]\nrule = \"pareto\"\npreview = 1\nminimize = "
+           "[\"elastic_energy\"]\nmaximize = [\"max_displacement\"]\n"));
+  ASSERT_EQ(pareto.refine.objectives.size(), 2u);
+  EXPECT_EQ(pareto.refine.objectives[1].preference, db::Preference::largest);
+  EXPECT_EQ(jobs::new_jobs(pareto).front().preview_levels, 1);
+
+  const auto threshold = read_sweep(write_sweep(
+      dir, "depth = 2\nrefine = { rule = \"threshold\", by = \"elastic_energy\", above = 1, "
+           "below = 2.5 }\n"));
+  EXPECT_EQ(threshold.refine.conditions.size(), 2u);
+  const auto changed = read_sweep(write_sweep(
+      dir, "depth = 3\nrefine = { rule = \"changed\", by = \"max_displacement\", above = 0.05 }\n"));
+  EXPECT_EQ(changed.refine.change_above, 0.05);
+  const auto none = read_sweep(write_sweep(dir, "depth = 2\nrefine = \"none\"\n"));
+  EXPECT_EQ(none.refine.kind, db::RefineKind::none);
+  EXPECT_EQ(jobs::new_jobs(none).front().preview_levels, 1);
+}
+
+TEST(SweepFileRefine, TheRuleIsNotPartOfAJobsIdentity) {
+  const auto dir = sweep_dir();
+  const std::string grid = "depth = 3\n[grid]\n\"" + kH + "\" = [1e-3, 2e-3]\n";
+  const auto all = read_sweep(write_sweep(dir, "refine = \"all\"\n" + grid, "a.toml"));
+  const auto plain = read_sweep(write_sweep(dir, grid, "p.toml"));
+  const auto coarse = read_sweep(write_sweep(
+      dir, "refine = { rule = \"top\", by = \"seconds\", count = 1 }\n" + grid, "c.toml"));
+  for (std::size_t i = 0; i < plain.jobs.size(); ++i) {
+    EXPECT_EQ(all.jobs[i].id, plain.jobs[i].id);
+    EXPECT_EQ(coarse.jobs[i].id, plain.jobs[i].id);
+  }
+  EXPECT_FALSE(jobs::new_jobs(all).front().preview_levels);
+}
+
+class BadRefine : public ::testing::TestWithParam<BadSweep> {};
+
+TEST_P(BadRefine, IsRefusedAtItsLineNamingTheKeyAndTheChoices) {
+  const auto dir = sweep_dir();
+  const auto file = write_sweep(dir, GetParam().body);
+  const std::string message = error_of(file);
+  EXPECT_NE(message.find(GetParam().expected), std::string::npos) << message;
+  EXPECT_EQ(message.rfind(fmt::format("{}:{}: ", file.string(), GetParam().line), 0), 0u)
+      << message;
+}
+
+// Lines: 1 name, 2 scene, 3 onwards the body.
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadRefine,
+    ::testing::Values(
+        BadSweep{"depth = 3\nrefine = \"some\"\n", "use \"all\", \"none\" or a table", 4},
+        BadSweep{"depth = 3\nrefine = 2\n", "'refine' must be \"all\", \"none\" or a table", 4},
+        BadSweep{"depth = 3\nrefine = { rule = \"topk\" }\n",
+                 "unknown rule 'topk' in 'refine' (did you mean 'top'?); valid rules: changed, "
+                 "none, pareto, threshold, top",
+                 4},
+        BadSweep{"depth = 3\nrefine = { by = \"seconds\" }\n", "'rule' in 'refine' must name", 4},
+        BadSweep{"depth = 3\n[refine]\nrule = \"top\"\nby = \"max_displacment\"\ncount = 1\n",
+                 "(did you mean 'max_displacement'?); valid outputs: max_displacement, "
+                 "elastic_energy",
+                 6},
+        BadSweep{"depth = 3\n[refine]\nrule = \"top\"\nby = \"seconds\"\n",
+                 "'refine' with this rule needs 'count'", 4},
+        BadSweep{"depth = 3\n[refine]\nrule = \"top\"\nby = \"seconds\"\ncount = 0\n",
+                 "'count' in 'refine' must be a positive integer", 7},
+        BadSweep{"depth = 3\n[refine]\nrule = \"top\"\nby = \"seconds\"\ncount = 1\nabove = 2\n",
+                 "unknown key 'above' in 'refine' with rule = \"top\"", 8},
+        BadSweep{"depth = 3\n[refine]\nrule = \"top\"\nby = \"seconds\"\ncount = 1\norder = "
+                 "\"big\"\n",
+                 "must be \"largest\" or \"smallest\"", 8},
+        BadSweep{"depth = 3\nrefine = { rule = \"threshold\", by = \"seconds\" }\n",
+                 "needs 'above', 'below' or both", 4},
+        BadSweep{"depth = 3\nrefine = { rule = \"pareto\", minimize = [\"seconds\"] }\n",
+                 "needs two different outputs", 4},
+        BadSweep{"depth = 3\nrefine = { rule = \"changed\", by = \"seconds\" }\n",
+                 "needs 'count' (how many points) or 'above'", 4},
+        BadSweep{"refine = \"none\"\n", "has depth 1 and 0 preview levels; give the sweep depth 2",
+                 3},
+        BadSweep{"depth = 3\n[refine]\nrule = \"none\"\npreview = 3\n",
+                 "lower 'preview' below the depth", 6},
+        BadSweep{"depth = 2\nrefine = { rule = \"changed\", by = \"seconds\", count = 1 }\n",
+                 "compares the last two preview levels", 4},
+        BadSweep{"depth = 3\nrefin = \"none\"\n", "did you mean 'refine'", 4}));
 
 }  // namespace
 }  // namespace psq
