@@ -52,10 +52,16 @@ struct RigidMotion {
   double angle_degrees = 0.0;
 };
 
+/// Which Cartesian components (x, y, z) a pinned set fixes; the others stay free unknowns of its
+/// vertices. Axis-aligned only: a roller on a plane normal to an axis, a symmetry plane normal
+/// to an axis, a rigid diaphragm in an axis plane.
+using PinComponents = std::array<bool, 3>;
+
 struct PinnedSet {
   std::string name;
   VertexSelector selector;
-  std::vector<RigidMotion> motions;  ///< empty: fixed in place
+  std::vector<RigidMotion> motions;  ///< empty: fixed in place; else they prescribe `components`
+  PinComponents components{true, true, true};  ///< the `components` key; all three by default
 };
 
 /// An external force. `Point` spreads the total force equally over the selected vertices;

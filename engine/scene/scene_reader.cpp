@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cmath>
 #include <set>
@@ -537,11 +538,43 @@ std::string read_name(const Section& section) {
   return name;
 }
 
+/// The optional `components` of a pin: a non-empty list of distinct names among "x", "y", "z"
+/// (all three when absent).
+PinComponents read_pin_components(const Section& section) {
+  static const Keys kNames = {"x", "y", "z"};
+  if (!section.has("components")) return {true, true, true};
+  const auto names = section.get<std::vector<std::string>>("components", {});
+  section.check(!names.empty(), "components",
+                "a non-empty list of the fixed components among 'x', 'y', 'z' (omit the key to "
+                "fix all three)");
+  PinComponents fixed{false, false, false};
+  for (const std::string& name : names) {
+    const auto it = std::find(kNames.begin(), kNames.end(), name);
+    if (it == kNames.end()) {
+      // Every one-letter name is one edit from each choice, so only a change of case counts as
+      // a typo worth suggesting.
+      std::string lower = name;
+      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const bool wrong_case = std::find(kNames.begin(), kNames.end(), lower) != kNames.end();
+      const std::string hint = wrong_case ? fmt::format("did you mean '{}'? ", lower) : "";
+      section.fail(section.line("components"),
+                   fmt::format("unknown component '{}' in 'components' {}; {}expected one of {}",
+                               name, section.where(), hint, quoted_list(kNames)));
+    }
+    bool& slot = fixed[static_cast<std::size_t>(it - kNames.begin())];
+    section.check(!slot, "components",
+                  fmt::format("a list of distinct components ('{}' is listed twice)", name));
+    slot = true;
+  }
+  return fixed;
+}
+
 PinnedSet read_pin(const Section& section) {
-  section.allow_only(with_selector_keys({"name", "motion"}));
+  section.allow_only(with_selector_keys({"name", "components", "motion"}));
   PinnedSet pin;
   pin.name = read_name(section);
   pin.selector = read_selector(section);
+  pin.components = read_pin_components(section);
   for (const Section& motion : section.tables("motion")) pin.motions.push_back(read_motion(motion));
   return pin;
 }

@@ -57,6 +57,7 @@ translation = [0.3, 0, 0]
 [[shell.pin]]
 name = "rim"
 boundary_loop = 1
+components = ["z", "x"]
 
 [[shell.load]]
 kind = "line"
@@ -165,6 +166,8 @@ TEST(ReadScene, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(rim.selector.kind, VertexSelector::Kind::BoundaryLoop);
   EXPECT_EQ(rim.selector.boundary_loop, 1);
   EXPECT_TRUE(rim.motions.empty());
+  EXPECT_EQ(edge.components, (PinComponents{true, true, true}));  // default: all three
+  EXPECT_EQ(rim.components, (PinComponents{true, false, true}));
   ASSERT_EQ(plate.loads.size(), 1u);
   EXPECT_EQ(plate.loads[0].kind, Load::Kind::Line);
   EXPECT_EQ(plate.loads[0].selector.kind, VertexSelector::Kind::BoundaryLoop);
@@ -422,6 +425,24 @@ const std::vector<BadCase> kBadCases = {
     {"zero_scale", 8,
      "name = \"sheet\"\nplacement = { scale = 0 }",
      9, {"'scale' in [shell.placement]", "positive"}},
+    {"empty_pin_components", 12,
+     "name = \"left\"\ncomponents = []",
+     13, {"'components' in [shell.pin]", "non-empty list", "'x', 'y', 'z'"}},
+    {"unknown_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"x\", \"w\"]",
+     13, {"unknown component 'w' in 'components' in [shell.pin]", "expected one of 'x', 'y', 'z'"}},
+    {"upper_case_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"Z\"]",
+     13, {"unknown component 'Z'", "did you mean 'z'?"}},
+    {"repeated_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"x\", \"y\", \"x\"]",
+     13, {"'components' in [shell.pin]", "distinct", "'x' is listed twice"}},
+    {"pin_components_not_strings", 12,
+     "name = \"left\"\ncomponents = \"x\"",
+     13, {"expected an array of strings for 'components'"}},
+    {"pin_component_misspelt_key", 12,
+     "name = \"left\"\ncomponent = [\"x\"]",
+     13, {"unknown key 'component' in [shell.pin]", "did you mean 'components'?"}},
     {"no_selector", 13,
      "",
      11, {"missing a vertex selector in [shell.pin]", "'box'", "'vertices'"}},
