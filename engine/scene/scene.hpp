@@ -17,11 +17,14 @@ namespace psq {
 /// Where a shell's mesh comes from: a file (OBJ, PLY, OFF) or a generator, then a rigid
 /// placement (scale, then rotation about the origin, then translation).
 struct MeshSource {
-  enum class Kind { File, Sheet, Cylinder, Sphere } kind = Kind::Sheet;
+  enum class Kind { File, Sheet, Cylinder, Sphere, CylindricalPanel, SphericalPanel } kind =
+      Kind::Sheet;
   std::filesystem::path file;  ///< Kind::File, resolved relative to the scene file
   SheetGenerator sheet;
   CylinderGenerator cylinder;
   SphereGenerator sphere;
+  CylindricalPanelGenerator cylindrical_panel;
+  SphericalPanelGenerator spherical_panel;
   double scale = 1.0;
   Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
   double rotation_degrees = 0.0;
