@@ -37,7 +37,10 @@ struct HierarchySettings {
 /// One level of the hierarchy.
 struct HierarchyLevel {
   TriMesh rest;  ///< this level's rest mesh
-  /// Per vertex: the pinned set holding it, or kFreeVertex. A pinned vertex keeps its finest
+  /// Per vertex: its pin group, or kFreeVertex. A group is an opaque id here; for a shell it is
+  /// the pin condition of LevelShellMesh::pin_group (engine/sim/shell_system.hpp: which set
+  /// prescribes which components), so every coarse pinned vertex, a finest vertex kept in place,
+  /// holds exactly the components it holds on the finest mesh. A pinned vertex keeps its finest
   /// rest position at every level, so that one rigid motion places it consistently.
   std::vector<int> pin_group;
   /// Every vertex of the finest level located on this level: the direct map U^l.

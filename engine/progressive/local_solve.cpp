@@ -3,13 +3,10 @@
 namespace psq {
 
 DofMap movable_vertex_dofs(const ShellSystem& system, const std::vector<bool>& movable) {
-  std::vector<bool> fixed(movable.size());
-  for (std::size_t v = 0; v < movable.size(); ++v) fixed[v] = !movable[v];
-  for (const PinnedVertex& pin : system.pinned()) fixed[pin.vertex] = true;
-  std::vector<int> fixed_vertices;
-  for (std::size_t v = 0; v < fixed.size(); ++v)
-    if (fixed[v]) fixed_vertices.push_back(static_cast<int>(v));
-  return DofMap(static_cast<Eigen::Index>(movable.size()), fixed_vertices);
+  std::vector<bool> fixed = system.fixed_dofs();
+  for (std::size_t v = 0; v < movable.size(); ++v)
+    if (!movable[v]) fixed[3 * v] = fixed[3 * v + 1] = fixed[3 * v + 2] = true;
+  return DofMap(fixed);
 }
 
 void balance_barrier_stiffness(ContactTerm& contact, const Eigen::VectorXd& x,

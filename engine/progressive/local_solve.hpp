@@ -12,8 +12,8 @@
 
 namespace psq {
 
-/// The DOFs of the `movable` vertices of `system` free, of every other vertex and of every
-/// pinned one fixed.
+/// The DOFs of the `movable` vertices of `system` free, except those its pins fix; every DOF of
+/// the other vertices fixed.
 DofMap movable_vertex_dofs(const ShellSystem& system, const std::vector<bool>& movable);
 
 /// Sets the contact term's κ by IPC's initial rule at x, balancing the barrier against

@@ -222,7 +222,7 @@ std::vector<LevelShellMesh> ProgressiveSimulation::level_shells(int level) const
   for (std::size_t s = 0; s < finest_.shells().size(); ++s) {
     const MeshHierarchy& h = hierarchies_[s];
     const HierarchyLevel& shell = h.levels[shell_level(h, level, level_count_)];
-    shells.push_back({shell.rest, shell.pin_group});
+    shells.push_back({shell.rest, shell.pin_group, finest_.shared_pins(static_cast<int>(s))});
   }
   return shells;
 }

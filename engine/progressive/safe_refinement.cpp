@@ -407,6 +407,8 @@ Eigen::VectorXd safe_initialize(const ShellSystem& fine, const std::vector<int>&
   const double bbox_diagonal = bounding_box_diagonal(fine.rest_mesh().vertices);
   const double perturbation_floor = kPerturbationFloor * bbox_diagonal;
   const int n = static_cast<int>(parent.size());
+  // A vertex with any fixed component is held whole by the local relaxations: they only make
+  // room, and the level's own solve then moves its free components.
   std::vector<bool> pinned(n, false);
   for (const PinnedVertex& pin : fine.pinned()) pinned[pin.vertex] = true;
   const int coarse_count = static_cast<int>(color.size());

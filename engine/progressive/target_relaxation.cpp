@@ -82,6 +82,7 @@ RelaxationStats relax_toward_targets(const ShellSystem& fine, const Eigen::Vecto
     if (std::sqrt(pair_distance(pair, x)) < safe_gap)
       for (int v : pair.vertices)
         if (v >= 0) freed[v] = true;
+  // Held whole, even with free components: the relaxation only makes room (safe_refinement).
   for (const PinnedVertex& pin : fine.pinned()) freed[pin.vertex] = false;
   Positions p = as_positions(x);
   const RelaxationStats stats =

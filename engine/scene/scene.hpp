@@ -17,11 +17,14 @@ namespace psq {
 /// Where a shell's mesh comes from: a file (OBJ, PLY, OFF) or a generator, then a rigid
 /// placement (scale, then rotation about the origin, then translation).
 struct MeshSource {
-  enum class Kind { File, Sheet, Cylinder, Sphere } kind = Kind::Sheet;
+  enum class Kind { File, Sheet, Cylinder, Sphere, CylindricalPanel, SphericalPanel } kind =
+      Kind::Sheet;
   std::filesystem::path file;  ///< Kind::File, resolved relative to the scene file
   SheetGenerator sheet;
   CylinderGenerator cylinder;
   SphereGenerator sphere;
+  CylindricalPanelGenerator cylindrical_panel;
+  SphericalPanelGenerator spherical_panel;
   double scale = 1.0;
   Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
   double rotation_degrees = 0.0;
@@ -52,10 +55,16 @@ struct RigidMotion {
   double angle_degrees = 0.0;
 };
 
+/// Which Cartesian components (x, y, z) a pinned set fixes; the others stay free unknowns of its
+/// vertices. Axis-aligned only: a roller on a plane normal to an axis, a symmetry plane normal
+/// to an axis, a rigid diaphragm in an axis plane.
+using PinComponents = std::array<bool, 3>;
+
 struct PinnedSet {
   std::string name;
   VertexSelector selector;
-  std::vector<RigidMotion> motions;  ///< empty: fixed in place
+  std::vector<RigidMotion> motions;  ///< empty: fixed in place; else they prescribe `components`
+  PinComponents components{true, true, true};  ///< the `components` key; all three by default
 };
 
 /// An external force. `Point` spreads the total force equally over the selected vertices;

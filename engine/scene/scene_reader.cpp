@@ -5,8 +5,10 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cmath>
+#include <numbers>
 #include <set>
 #include <type_traits>
 
@@ -304,6 +306,10 @@ int read_count(const Section& section, std::string_view key, int fallback) {
 const Keys kSheetKeys = {"generator", "width", "height", "edge_length", "structured", "holes"};
 const Keys kCylinderKeys = {"generator", "radius", "height", "edge_length"};
 const Keys kSphereKeys = {"generator", "radius", "edge_length"};
+const Keys kCylindricalPanelKeys = {"generator", "radius", "height", "angle_degrees",
+                                    "edge_length"};
+const Keys kSphericalPanelKeys = {"generator",         "radius",          "polar_min_degrees",
+                                  "polar_max_degrees", "azimuth_degrees", "edge_length"};
 
 /// The target edge length, which must be positive and smaller than the shape's smallest size.
 double read_edge_length(const Section& mesh, double smallest_size, std::string_view size_name) {
@@ -368,6 +374,44 @@ SphereGenerator read_sphere(const Section& mesh) {
   return sphere;
 }
 
+/// An angle in degrees in (low, high], or (low, high) when the bound is not allowed; required
+/// without a fallback.
+double read_angle(const Section& mesh, std::string_view key, std::optional<double> fallback,
+                  double low, double high, bool high_allowed) {
+  const double value =
+      fallback ? mesh.get<double>(key, *fallback) : mesh.get_required<double>(key);
+  mesh.check(value > low && (high_allowed ? value <= high : value < high), key,
+             fmt::format("in ({:g}, {:g}{} degrees (got {:g})", low, high,
+                         high_allowed ? "]" : ")", value));
+  return value;
+}
+
+CylindricalPanelGenerator read_cylindrical_panel(const Section& mesh) {
+  mesh.allow_only(kCylindricalPanelKeys);
+  CylindricalPanelGenerator panel;
+  panel.radius = read_positive(mesh, "radius");
+  panel.height = read_positive(mesh, "height");
+  panel.angle_degrees = read_angle(mesh, "angle_degrees", 360.0, 0, 360, true);
+  const double arc = panel.radius * panel.angle_degrees * std::numbers::pi / 180.0;
+  panel.edge_length =
+      read_edge_length(mesh, std::min(arc, panel.height), "panel's arc length and height");
+  return panel;
+}
+
+SphericalPanelGenerator read_spherical_panel(const Section& mesh) {
+  mesh.allow_only(kSphericalPanelKeys);
+  SphericalPanelGenerator panel;
+  panel.radius = read_positive(mesh, "radius");
+  panel.polar_min_degrees = read_angle(mesh, "polar_min_degrees", std::nullopt, 0, 180, false);
+  panel.polar_max_degrees =
+      read_angle(mesh, "polar_max_degrees", 90.0, panel.polar_min_degrees, 180, false);
+  panel.azimuth_degrees = read_angle(mesh, "azimuth_degrees", 360.0, 0, 360, true);
+  const double meridian =
+      panel.radius * (panel.polar_max_degrees - panel.polar_min_degrees) * std::numbers::pi / 180.0;
+  panel.edge_length = read_edge_length(mesh, meridian, "panel's meridian length");
+  return panel;
+}
+
 /// A mesh file, resolved relative to the scene file's directory; it must exist.
 fs::path read_mesh_file(const Section& mesh, const fs::path& scene_path) {
   mesh.allow_only({"file"});
@@ -411,13 +455,21 @@ MeshSource read_mesh_source(const Section& shell, const fs::path& scene_path) {
   } else if (!mesh.has("generator")) {
     mesh.fail(mesh.line(), fmt::format("missing 'file' or 'generator' {}", mesh.where()));
   } else {
-    const std::string generator = read_choice(mesh, "generator", {"sheet", "cylinder", "sphere"});
+    const std::string generator =
+        read_choice(mesh, "generator",
+                    {"sheet", "cylinder", "sphere", "cylindrical_panel", "spherical_panel"});
     if (generator == "sheet") {
       source.kind = MeshSource::Kind::Sheet;
       source.sheet = read_sheet(mesh);
     } else if (generator == "cylinder") {
       source.kind = MeshSource::Kind::Cylinder;
       source.cylinder = read_cylinder(mesh);
+    } else if (generator == "cylindrical_panel") {
+      source.kind = MeshSource::Kind::CylindricalPanel;
+      source.cylindrical_panel = read_cylindrical_panel(mesh);
+    } else if (generator == "spherical_panel") {
+      source.kind = MeshSource::Kind::SphericalPanel;
+      source.spherical_panel = read_spherical_panel(mesh);
     } else {
       source.kind = MeshSource::Kind::Sphere;
       source.sphere = read_sphere(mesh);
@@ -537,11 +589,43 @@ std::string read_name(const Section& section) {
   return name;
 }
 
+/// The optional `components` of a pin: a non-empty list of distinct names among "x", "y", "z"
+/// (all three when absent).
+PinComponents read_pin_components(const Section& section) {
+  static const Keys kNames = {"x", "y", "z"};
+  if (!section.has("components")) return {true, true, true};
+  const auto names = section.get<std::vector<std::string>>("components", {});
+  section.check(!names.empty(), "components",
+                "a non-empty list of the fixed components among 'x', 'y', 'z' (omit the key to "
+                "fix all three)");
+  PinComponents fixed{false, false, false};
+  for (const std::string& name : names) {
+    const auto it = std::find(kNames.begin(), kNames.end(), name);
+    if (it == kNames.end()) {
+      // Every one-letter name is one edit from each choice, so only a change of case counts as
+      // a typo worth suggesting.
+      std::string lower = name;
+      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const bool wrong_case = std::find(kNames.begin(), kNames.end(), lower) != kNames.end();
+      const std::string hint = wrong_case ? fmt::format("did you mean '{}'? ", lower) : "";
+      section.fail(section.line("components"),
+                   fmt::format("unknown component '{}' in 'components' {}; {}expected one of {}",
+                               name, section.where(), hint, quoted_list(kNames)));
+    }
+    bool& slot = fixed[static_cast<std::size_t>(it - kNames.begin())];
+    section.check(!slot, "components",
+                  fmt::format("a list of distinct components ('{}' is listed twice)", name));
+    slot = true;
+  }
+  return fixed;
+}
+
 PinnedSet read_pin(const Section& section) {
-  section.allow_only(with_selector_keys({"name", "motion"}));
+  section.allow_only(with_selector_keys({"name", "components", "motion"}));
   PinnedSet pin;
   pin.name = read_name(section);
   pin.selector = read_selector(section);
+  pin.components = read_pin_components(section);
   for (const Section& motion : section.tables("motion")) pin.motions.push_back(read_motion(motion));
   return pin;
 }

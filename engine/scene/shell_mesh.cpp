@@ -22,6 +22,10 @@ TriMesh generate(const MeshSource& source) {
       return make_cylinder(source.cylinder);
     case MeshSource::Kind::Sphere:
       return make_sphere(source.sphere);
+    case MeshSource::Kind::CylindricalPanel:
+      return make_cylindrical_panel(source.cylindrical_panel);
+    case MeshSource::Kind::SphericalPanel:
+      return make_spherical_panel(source.spherical_panel);
   }
   throw InputError("mesh source of unknown kind");
 }

@@ -85,7 +85,7 @@ NewtonSolver::Progress numbered_through_frame(NewtonSolver::Progress progress, i
 FrameSolver::FrameSolver(const ShellSystem& system, IncrementalPotential& potential)
     : system_(system),
       potential_(potential),
-      dofs_(system.rest_mesh().vertex_count(), system.pinned_vertex_indices()),
+      dofs_(system.fixed_dofs()),
       pull_weight_floor_(stiffest_membrane(system.scene())) {
   const Scene& scene = system.scene();
   if (contact_enabled(scene)) {
@@ -122,23 +122,28 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
   contact_->initialize_stiffness(x, base_gradient, free, potential_.inertia_weight());
   if (move_scripted_vertices_if_safe(x, record.time)) return;
 
-  // Pull the vertices whose targets moved; the others stay fixed.
+  // Pull the fixed components of the vertices whose targets moved; the others stay fixed, and
+  // free components stay free.
   Eigen::VectorXd target = x;
   system_.apply_pins(target, record.time);
-  std::vector<int> pulled, held;
-  std::vector<double> weights;
+  std::vector<int> pulled;
+  std::vector<Eigen::Vector3d> weights;
+  std::vector<bool> held(x.size(), false);
   for (const PinnedVertex& p : system_.pinned()) {
-    if (target.segment<3>(3 * p.vertex) == x.segment<3>(3 * p.vertex)) {
-      held.push_back(p.vertex);
+    const bool moved = target.segment<3>(3 * p.vertex) != x.segment<3>(3 * p.vertex);
+    if (!moved) {
+      for (int c = 0; c < 3; ++c) held[3 * p.vertex + c] = p.fixes(c);
       continue;
     }
     pulled.push_back(p.vertex);
     const double mass = std::max(system_.dof_masses()[3 * p.vertex], contact_->average_mass());
-    weights.push_back(std::max(potential_.inertia_weight() * mass, pull_weight_floor_));
+    const double weight = std::max(potential_.inertia_weight() * mass, pull_weight_floor_);
+    weights.push_back(Eigen::Vector3d(p.fixes(0) ? weight : 0.0, p.fixes(1) ? weight : 0.0,
+                                      p.fixes(2) ? weight : 0.0));
   }
   pull_.set(std::move(pulled), target, std::move(weights));
   potential_.add_term(pull_);
-  const DofMap pulled_dofs(system_.rest_mesh().vertex_count(), held);
+  const DofMap pulled_dofs(held);
   pull_.set_stiffness(kInitialPullStiffness);
   for (int round = 0; round < kMaxPullRounds; ++round) {
     append_solve(record.newton, solve_in_chunks(x, pulled_dofs, settings, progress));

@@ -2,7 +2,8 @@
 // How scripted vertices (pinned shell sets, collider vertices) reach their targets safely when
 // contact is on. Moving them directly could push a collider through a shell, so when the CCD
 // says the direct move is not safe, they become unknowns pulled toward their targets by
-//   P(x) = ½ k Σᵢ wᵢ ‖xᵢ − yᵢ‖²,   wᵢ = max(mᵢ/Δt², E h/(1 − ν²)),
+//   P(x) = ½ k Σᵢ Σ_c wᵢ_c (xᵢ_c − yᵢ_c)²,   wᵢ_c = max(mᵢ/Δt², E h/(1 − ν²)),
+// over the components c a pin fixes (wᵢ_c = 0 on a free component, which the pull leaves free),
 // and the solver's CCD line search keeps every iterate intersection-free (IPC's treatment of
 // kinematic boundary conditions, with a penalty of growing stiffness k in place of the
 // augmented Lagrangian's multipliers). IPC weighs by mass alone, which suits dynamics; in a
@@ -20,24 +21,24 @@ namespace psq {
 
 class KinematicPull : public PotentialTerm {
  public:
-  /// The vertices to pull, their targets (3 per vertex, in a vector of 3n like x) and weights.
-  void set(std::vector<int> vertices, const Eigen::VectorXd& targets, std::vector<double> weights);
+  /// The vertices to pull, their targets (3 per vertex, in a vector of 3n like x) and weights,
+  /// one per component (0 for a component the pull leaves alone).
+  void set(std::vector<int> vertices, const Eigen::VectorXd& targets,
+           std::vector<Eigen::Vector3d> weights);
   void set_stiffness(double k) { stiffness_ = k; }
   [[nodiscard]] double stiffness() const { return stiffness_; }
   [[nodiscard]] const std::vector<int>& vertices() const { return vertices_; }
-  /// maxᵢ ‖xᵢ − yᵢ‖ over the pulled vertices (0 without any).
-  [[nodiscard]] double largest_offset(const Eigen::VectorXd& x) const;
 
   double value(const Eigen::VectorXd& x) override;
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
-  /// Diagonal only: k wᵢ on the three DOFs of each pulled vertex.
+  /// Diagonal only: k wᵢ_c on the DOFs of each pulled vertex.
   void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
                Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
 
  private:
   std::vector<int> vertices_;
   Eigen::VectorXd targets_;
-  std::vector<double> weights_;
+  std::vector<Eigen::Vector3d> weights_;
   double stiffness_ = 1.0;
 };
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <set>
 #include <stdexcept>
 
@@ -36,7 +37,42 @@ std::vector<double> line_load_weights(const TriMesh& mesh, const MeshTopology& t
   return weight;
 }
 
+/// The fixed components of a vertex that set `set` alone pins.
+PinSources single_set_sources(const PinnedSet& pin, int set) {
+  PinSources sources{-1, -1, -1};
+  for (int c = 0; c < 3; ++c)
+    if (pin.components[c]) sources[c] = set;
+  return sources;
+}
+
+/// The pin group (LevelShellMesh::pin_group) of a vertex whose components `sources` fixes:
+/// the set index when one set prescribes them all, else S + its index in `shared` (appended
+/// when new), so that vertices under the same condition share a group.
+int pin_group_of(const PinSources& sources, int set_count, std::vector<PinSources>& shared) {
+  int only = -1;
+  bool mixed = false;
+  for (int set : sources) {
+    if (set < 0) continue;
+    if (only >= 0 && set != only) mixed = true;
+    only = set;
+  }
+  if (!mixed) return only;
+  const auto it = std::find(shared.begin(), shared.end(), sources);
+  if (it != shared.end()) return set_count + static_cast<int>(it - shared.begin());
+  shared.push_back(sources);
+  return set_count + static_cast<int>(shared.size()) - 1;
+}
+
 }  // namespace
+
+void ShellSystem::add_pinned(int shell, int v, const Eigen::Vector3d& rest,
+                             const PinSources& sources, int group) {
+  const std::vector<PinnedSet>& pins = scene_.shells[shell].pins;
+  PinnedVertex pinned{shells_[shell].first_vertex + v, rest, {nullptr, nullptr, nullptr}, group};
+  for (int c = 0; c < 3; ++c)
+    if (sources[c] >= 0) pinned.motions[c] = &pins[sources[c]].motions;
+  pinned_.push_back(pinned);
+}
 
 ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
   std::vector<TriMesh> meshes;
@@ -50,12 +86,20 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
     const Shell& shell = scene_.shells[s];
     const ShellBlock& block = shells_[s];
     const TriMesh& mesh = meshes[s];
+    // Per vertex, each component from the first set (in scene order) that fixes it.
+    std::vector<PinSources> sources(mesh.vertex_count(), PinSources{-1, -1, -1});
     for (std::size_t k = 0; k < shell.pins.size(); ++k) {
       const PinnedSet& pin = shell.pins[k];
       const auto what = fmt::format("pin '{}' of shell '{}'", pin.name, shell.name);
       for (int v : select_vertices(pin.selector, mesh, block.topology, what))
-        pinned_.push_back({block.first_vertex + v, mesh.vertices.row(v).transpose(), &pin.motions,
-                           static_cast<int>(k)});
+        for (int c = 0; c < 3; ++c)
+          if (pin.components[c] && sources[v][c] < 0) sources[v][c] = static_cast<int>(k);
+    }
+    std::vector<PinSources>& shared = shared_pins_[s];
+    for (int v = 0; v < mesh.vertex_count(); ++v) {
+      const int group = pin_group_of(sources[v], static_cast<int>(shell.pins.size()), shared);
+      if (group >= 0)
+        add_pinned(static_cast<int>(s), v, mesh.vertices.row(v).transpose(), sources[v], group);
     }
     for (std::size_t l = 0; l < shell.loads.size(); ++l) {
       const Load& load = shell.loads[l];
@@ -76,9 +120,6 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
             load.total_force * weight[k] / total;
     }
   }
-  // A vertex pinned by two sets keeps the first one's motion.
-  std::set<int> seen;
-  std::erase_if(pinned_, [&](const PinnedVertex& p) { return !seen.insert(p.vertex).second; });
   add_colliders(scene_collider_meshes());
 }
 
@@ -97,16 +138,24 @@ ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& 
   add_shells(meshes);
   for (std::size_t s = 0; s < shells_.size(); ++s) {
     const std::vector<PinnedSet>& pins = scene_.shells[s].pins;
+    const int set_count = static_cast<int>(pins.size());
+    shared_pins_[s] = shells[s].shared_pins;
+    for (const PinSources& sources : shared_pins_[s])
+      for (int set : sources)
+        if (set >= set_count)
+          throw std::invalid_argument(fmt::format(
+              "ShellSystem: a shared pin of shell '{}' names set {}", scene_.shells[s].name, set));
     for (int v = 0; v < shells_[s].vertex_count; ++v) {
       const int group = shells[s].pin_group[v];
       if (group < 0) continue;
-      if (group >= static_cast<int>(pins.size()))
+      if (group >= set_count + static_cast<int>(shared_pins_[s].size()))
         throw std::invalid_argument(
             fmt::format("ShellSystem: pin group {} of shell '{}' does not "
                         "exist",
                         group, scene_.shells[s].name));
-      pinned_.push_back({shells_[s].first_vertex + v, meshes[s].vertices.row(v).transpose(),
-                         &pins[group].motions, group});
+      const PinSources sources = group < set_count ? single_set_sources(pins[group], group)
+                                                   : shared_pins_[s][group - set_count];
+      add_pinned(static_cast<int>(s), v, meshes[s].vertices.row(v).transpose(), sources, group);
     }
   }
   if (!colliders.empty() && colliders.size() != scene_.colliders.size())
@@ -140,8 +189,10 @@ void ShellSystem::add_colliders(const std::vector<TriMesh>& meshes) {
     dof_masses_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
     external_force_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
     for (int v = 0; v < block.vertex_count; ++v)
-      pinned_.push_back(
-          {block.first_vertex + v, mesh.vertices.row(v).transpose(), &collider.motions, -1});
+      pinned_.push_back({block.first_vertex + v,
+                         mesh.vertices.row(v).transpose(),
+                         {&collider.motions, &collider.motions, &collider.motions},
+                         -1});
     colliders_.push_back(std::move(block));
   }
 }
@@ -160,6 +211,7 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
     vertices += block.vertex_count;
     triangles += block.triangle_count;
     shells_.push_back(std::move(block));
+    shared_pins_.emplace_back();
   }
   if (shells_.empty())
     throw InputError(fmt::format("{}: the scene has no [[shell]]", scene_.source.string()));
@@ -201,11 +253,12 @@ TriMesh ShellSystem::block_rest_mesh(const MeshBlock& block) const {
   return mesh;
 }
 
-std::vector<int> ShellSystem::pinned_vertex_indices() const {
-  std::vector<int> out;
-  out.reserve(pinned_.size());
-  for (const PinnedVertex& p : pinned_) out.push_back(p.vertex);
-  return out;
+std::vector<bool> ShellSystem::fixed_dofs() const {
+  std::vector<bool> fixed(static_cast<std::size_t>(3 * rest_.vertex_count()), false);
+  for (const PinnedVertex& p : pinned_)
+    for (int c = 0; c < 3; ++c)
+      if (p.fixes(c)) fixed[static_cast<std::size_t>(3 * p.vertex + c)] = true;
+  return fixed;
 }
 
 std::vector<int> ShellSystem::pin_groups(int shell) const {
@@ -219,8 +272,19 @@ std::vector<int> ShellSystem::pin_groups(int shell) const {
 }
 
 void ShellSystem::apply_pins(Eigen::VectorXd& x, double time) const {
-  for (const PinnedVertex& p : pinned_)
-    x.segment<3>(3 * p.vertex) = apply_motions(*p.motions, p.rest, time);
+  for (const PinnedVertex& p : pinned_) {
+    // Components usually share their motions: place the point once per distinct motion list.
+    const std::vector<RigidMotion>* placed_by = nullptr;
+    Eigen::Vector3d placed;
+    for (int c = 0; c < 3; ++c) {
+      if (!p.fixes(c)) continue;
+      if (p.motions[c] != placed_by) {
+        placed_by = p.motions[c];
+        placed = apply_motions(*placed_by, p.rest, time);
+      }
+      x[3 * p.vertex + c] = placed[c];
+    }
+  }
 }
 
 }  // namespace psq

@@ -2,6 +2,7 @@
 // Everything the solver needs to know about a scene at one resolution, with all shells
 // concatenated into one vertex array: rest mesh, elastic energies, masses, pins, loads.
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -28,19 +29,33 @@ using ShellBlock = MeshBlock;
 /// vertices without mass or elastic energy.
 using ColliderBlock = MeshBlock;
 
-/// Pinned vertices and where their scripted motions take them.
+/// Per Cartesian component of a pinned vertex, the index of the pinned set (in its shell's
+/// `pins`) that prescribes it, or −1 when the component is free.
+using PinSources = std::array<int, 3>;
+
+/// Pinned vertices and where their scripted motions take their fixed components.
 struct PinnedVertex {
   int vertex;
   Eigen::Vector3d rest;
-  const std::vector<RigidMotion>* motions;
-  int group;  ///< index of the pinned set in its shell's `pins`; −1 for a collider vertex
+  /// Per component, the motions that prescribe it (from the vertex's rest position), or
+  /// nullptr when that component is a free unknown.
+  std::array<const std::vector<RigidMotion>*, 3> motions;
+  /// The vertex's pin group (LevelShellMesh::pin_group): a set index, a shared condition, or −1
+  /// for a collider vertex.
+  int group;
+  [[nodiscard]] bool fixes(int component) const { return motions[component] != nullptr; }
 };
 
-/// One shell of a hierarchy level: its rest mesh and, per vertex, the index of the pinned set
-/// (into the scene shell's `pins`) that holds it, or a negative number for a free vertex.
+/// One shell of a hierarchy level: its rest mesh and, per vertex, its pin group: negative for a
+/// free vertex; k < S (S = the scene shell's number of pins) when set k alone prescribes its
+/// fixed components (which are then set k's); S + i for the vertices several sets share, whose
+/// fixed components come from different sets as `shared_pins[i]` says. A vertex pinned by
+/// several sets fixes every component one of them fixes, each following the first set (in
+/// scene order) that fixes it.
 struct LevelShellMesh {
   TriMesh rest;
   std::vector<int> pin_group;
+  std::vector<PinSources> shared_pins;
 };
 
 class ShellSystem {
@@ -80,12 +95,19 @@ class ShellSystem {
   [[nodiscard]] const Eigen::VectorXd& dof_masses() const { return dof_masses_; }
   /// Constant external force per DOF (3n): gravity and loads.
   [[nodiscard]] const Eigen::VectorXd& external_force() const { return external_force_; }
+  /// The vertices with at least one fixed component (shell pins, then every collider vertex).
   [[nodiscard]] const std::vector<PinnedVertex>& pinned() const { return pinned_; }
-  [[nodiscard]] std::vector<int> pinned_vertex_indices() const;
-  /// Per vertex of shell `shell` (local numbering): the index of the pinned set holding it in
-  /// that shell's `pins`, or −1 when it is free.
+  /// Per DOF (3n), whether a pin fixes it.
+  [[nodiscard]] std::vector<bool> fixed_dofs() const;
+  /// Per vertex of shell `shell` (local numbering): its pin group (LevelShellMesh::pin_group),
+  /// −1 when it is free.
   [[nodiscard]] std::vector<int> pin_groups(int shell) const;
-  /// Sets the pinned vertices of x to their scripted positions at `time`.
+  /// The fixed components of shell `shell`'s pin groups S, S + 1, ... (LevelShellMesh).
+  [[nodiscard]] const std::vector<PinSources>& shared_pins(int shell) const {
+    return shared_pins_.at(shell);
+  }
+  /// Sets the fixed components of the pinned vertices of x to their scripted values at `time`;
+  /// free components are left as they are.
   void apply_pins(Eigen::VectorXd& x, double time) const;
 
  private:
@@ -98,6 +120,10 @@ class ShellSystem {
   /// Appends the colliders (one mesh per scene collider) after the shells: rest mesh, zero mass
   /// and force, and every collider vertex as a pinned vertex following the collider's motions.
   void add_colliders(const std::vector<TriMesh>& meshes);
+  /// Appends shell `shell`'s vertex `v` (local numbering, rest position `rest`) as pinned by
+  /// pin group `group` with the components `sources` fixes.
+  void add_pinned(int shell, int v, const Eigen::Vector3d& rest, const PinSources& sources,
+                  int group);
 
   Scene scene_;
   TriMesh rest_;
@@ -108,6 +134,7 @@ class ShellSystem {
   Eigen::VectorXd dof_masses_;
   Eigen::VectorXd external_force_;
   std::vector<PinnedVertex> pinned_;
+  std::vector<std::vector<PinSources>> shared_pins_;  ///< per shell, LevelShellMesh::shared_pins
 };
 
 }  // namespace psq

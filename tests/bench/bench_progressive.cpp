@@ -182,7 +182,8 @@ void run_scene(const psq::Scene& scene, const psq::ProgressiveSettings& settings
   const double direct_seconds = seconds_since(start);
 
   const psq::MeshHierarchy& h = sim.hierarchies().at(0);
-  const psq::ShellSystem coarse(scene, {{h.levels[0].rest, h.levels[0].pin_group}});
+  const psq::ShellSystem coarse(scene,
+                                {{h.levels[0].rest, h.levels[0].pin_group, fine.shared_pins(0)}});
   start = Clock::now();
   const psq::test::DirectRun direct_coarse =
       psq::test::settled_direct_run(coarse, sim.finest_tolerance());

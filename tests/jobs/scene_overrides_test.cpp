@@ -91,6 +91,29 @@ TEST(SceneOverrides, PinMotionsAreAddressedThroughTheirPinsName) {
   EXPECT_EQ(scene.shells[0].pins[0].motions.size(), 0u);
 }
 
+// A pin of chosen components keeps them under overrides of its motion's numbers; the list
+// itself is not a number and cannot be varied.
+TEST(SceneOverrides, PinsOfChosenComponentsKeepThemAndTheListIsNoPath) {
+  const SceneDocument document(R"(
+[[shell]]
+name = "sheet"
+mesh = { generator = "sheet", width = 1, height = 1, edge_length = 0.25 }
+material = { youngs_modulus = 1e6, poisson_ratio = 0.3, density = 100, thickness = 1e-3 }
+[[shell.pin]]
+name = "roller"
+box = { min = [-0.5, -0.5, 0], max = [-0.5, 0.5, 0] }
+components = ["z", "x"]
+[[shell.pin.motion]]
+translation = [0, 0, 0.1]
+)",
+                               "rollers.toml");
+  const Scene scene = document.apply({{"shell.sheet.pin.roller.motion.0.translation.2", 0.3}});
+  EXPECT_EQ(scene.shells[0].pins[0].motions[0].translation.z(), 0.3);
+  EXPECT_EQ(scene.shells[0].pins[0].components, (PinComponents{true, false, true}));
+  EXPECT_NE(canonical_refusal(document, "shell.sheet.pin.roller.components", 1).find("an array"),
+            std::string::npos);
+}
+
 TEST(SceneOverrides, ANameWithDotsSpansSeveralKeys) {
   const auto dir = test::fresh_temp_dir("scene_overrides");
   const auto file = test::write_file(

@@ -218,6 +218,86 @@ TEST(Generators, CylinderParametersAreChecked) {
                      "edge_length");
 }
 
+// ---- panels ----------------------------------------------------------------------------------
+
+/// Every face's right-hand normal points away from `center_of(centroid)`.
+template <class Center>
+void expect_outward(const TriMesh& m, Center&& center_of) {
+  for (int f = 0; f < m.triangle_count(); ++f) {
+    const Vector3d c = centroid(m, f);
+    EXPECT_GT(area_vector(m, f).dot(c - center_of(c)), 0) << "face " << f;
+  }
+}
+
+TEST(Generators, CylindricalPanelIsAnEvenGridOnTheArc) {
+  // Scordelis–Lo's roof: 80° of R = 25 (arc 34.9) by 50, edge 5: 7 → 8 by 10 cells.
+  const CylindricalPanelGenerator spec{
+      .radius = 25, .height = 50, .angle_degrees = 80, .edge_length = 5};
+  const TriMesh m = make_cylindrical_panel(spec);
+  EXPECT_NO_THROW(validate_mesh(m, "panel"));
+  EXPECT_EQ(m.vertex_count(), 9 * 11);
+  EXPECT_EQ(m.triangle_count(), 2 * 8 * 10);
+  const MeshTopology t = MeshTopology::build(m);
+  EXPECT_EQ(euler_characteristic(m, t), 1);
+  expect_outward(m, [](const Vector3d& c) { return Vector3d(0, 0, c.z()); });
+  double largest_angle = 0.0;
+  for (int v = 0; v < m.vertex_count(); ++v) {
+    EXPECT_NEAR(std::hypot(m.vertices(v, 0), m.vertices(v, 1)), 25, 1e-12);
+    largest_angle = std::max(largest_angle, std::atan2(m.vertices(v, 1), m.vertices(v, 0)));
+  }
+  EXPECT_NEAR(largest_angle, 40 * std::numbers::pi / 180, 1e-12);  // centred on +x
+}
+
+TEST(Generators, ClosedCylindricalPanelHasNoSeamAndQuarterTurnVertices) {
+  const TriMesh m = make_cylindrical_panel(
+      {.radius = 1, .height = 1, .angle_degrees = 360, .edge_length = 0.3});
+  EXPECT_NO_THROW(validate_mesh(m, "ring"));
+  const MeshTopology t = MeshTopology::build(m);
+  EXPECT_EQ(euler_characteristic(m, t), 0);
+  ASSERT_EQ(t.boundary_loops.size(), 2u);
+  EXPECT_EQ(t.boundary_loops[0].size(), 24u);  // 2π/0.3 = 20.9 → 24, a multiple of 4
+  expect_outward(m, [](const Vector3d& c) { return Vector3d(0, 0, c.z()); });
+  for (const Vector3d& p : {Vector3d(1, 0, 0.5), Vector3d(0, 1, 0.5), Vector3d(-1, 0, 0.5)}) {
+    bool found = false;
+    for (int v = 0; v < m.vertex_count(); ++v)
+      found = found || (m.vertices.row(v).transpose() - p).norm() < 1e-12;
+    EXPECT_TRUE(found) << p.transpose();
+  }
+}
+
+TEST(Generators, SphericalPanelIsAClosedZoneWithAHole) {
+  // The pinched hemisphere: R = 10, polar angles 18°..90°, edge 2: a meridian of 12.6 gives
+  // 6.3 → 8 rows, the equator of 62.8 gives 31.4 → 32 columns.
+  const TriMesh m = make_spherical_panel(
+      {.radius = 10, .polar_min_degrees = 18, .polar_max_degrees = 90, .edge_length = 2});
+  EXPECT_NO_THROW(validate_mesh(m, "hemisphere"));
+  EXPECT_EQ(m.vertex_count(), 32 * 9);
+  const MeshTopology t = MeshTopology::build(m);
+  EXPECT_EQ(euler_characteristic(m, t), 0);
+  ASSERT_EQ(t.boundary_loops.size(), 2u);
+  expect_outward(m, [](const Vector3d&) { return Vector3d::Zero(); });
+  double lowest = 1e9, highest = -1e9;
+  for (int v = 0; v < m.vertex_count(); ++v) {
+    EXPECT_NEAR(m.vertices.row(v).norm(), 10, 1e-12);
+    lowest = std::min(lowest, m.vertices(v, 2));
+    highest = std::max(highest, m.vertices(v, 2));
+  }
+  EXPECT_NEAR(lowest, 0, 1e-12);
+  EXPECT_NEAR(highest, 10 * std::cos(18 * std::numbers::pi / 180), 1e-12);
+}
+
+TEST(Generators, PanelParametersAreChecked) {
+  expect_input_error([] { make_cylindrical_panel({.radius = -1}); }, "radius");
+  expect_input_error([] { make_cylindrical_panel({.angle_degrees = 400}); }, "angle_degrees");
+  expect_input_error([] { make_cylindrical_panel({.height = 0.1, .edge_length = 0.2}); },
+                     "edge_length");
+  expect_input_error([] { make_spherical_panel({.polar_min_degrees = 0}); }, "polar_min_degrees");
+  expect_input_error(
+      [] { make_spherical_panel({.polar_min_degrees = 50, .polar_max_degrees = 40}); },
+      "polar_max_degrees");
+  expect_input_error([] { make_spherical_panel({.azimuth_degrees = 0}); }, "azimuth_degrees");
+}
+
 // ---- spheres ---------------------------------------------------------------------------------
 
 TEST(Generators, GeodesicSphereIsClosedOutwardAndOnTheRadius) {

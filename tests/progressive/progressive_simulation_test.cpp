@@ -86,7 +86,7 @@ void compare_with_direct_solves(const Scene& scene, ProgressiveSimulation& sim,
   const test::DirectRun direct_fine = test::settled_direct_run(fine, sim.tolerance());
   ASSERT_TRUE(direct_fine.settled);
   const HierarchyLevel& coarsest = sim.hierarchies().at(0).levels[0];
-  const ShellSystem coarse(scene, {{coarsest.rest, coarsest.pin_group}});
+  const ShellSystem coarse(scene, {{coarsest.rest, coarsest.pin_group, fine.shared_pins(0)}});
   const test::DirectRun direct_coarse = test::settled_direct_run(coarse, sim.tolerance());
   ASSERT_TRUE(direct_coarse.settled);
   const ShellProlongation to_finest(coarsest.rest, coarsest.finest, fine.rest_mesh().vertices);

@@ -22,7 +22,8 @@ struct ProxyFixture {
   test::NestedCase cylinder = test::nested_case("cylinder_compress", 5);
   ShellSystem finest{cylinder.scene};
   ShellSystem coarse{cylinder.scene,
-                     {{cylinder.hierarchy.levels[0].rest, cylinder.hierarchy.levels[0].pin_group}}};
+                     {{cylinder.hierarchy.levels[0].rest, cylinder.hierarchy.levels[0].pin_group,
+                       finest.shared_pins(0)}}};
   SystemProlongation to_finest{{ShellProlongation(cylinder.hierarchy.levels[0].rest,
                                                   cylinder.hierarchy.levels[0].finest,
                                                   finest.rest_mesh().vertices)}};
@@ -148,7 +149,7 @@ struct BendingCurvatures {
 /// nothing there. The proxy's curvature comes from finite differences of its exact gradient.
 BendingCurvatures bending_curvatures(const Scene& scene, const HierarchyLevel& level0) {
   const ShellSystem finest{scene};
-  const ShellSystem coarse{scene, {{level0.rest, level0.pin_group}}};
+  const ShellSystem coarse{scene, {{level0.rest, level0.pin_group, finest.shared_pins(0)}}};
   const SystemProlongation to_finest{
       {ShellProlongation(level0.rest, level0.finest, finest.rest_mesh().vertices)}};
   const double dt = scene.time.step;

@@ -57,6 +57,7 @@ translation = [0.3, 0, 0]
 [[shell.pin]]
 name = "rim"
 boundary_loop = 1
+components = ["z", "x"]
 
 [[shell.load]]
 kind = "line"
@@ -165,6 +166,8 @@ TEST(ReadScene, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(rim.selector.kind, VertexSelector::Kind::BoundaryLoop);
   EXPECT_EQ(rim.selector.boundary_loop, 1);
   EXPECT_TRUE(rim.motions.empty());
+  EXPECT_EQ(edge.components, (PinComponents{true, true, true}));  // default: all three
+  EXPECT_EQ(rim.components, (PinComponents{true, false, true}));
   ASSERT_EQ(plate.loads.size(), 1u);
   EXPECT_EQ(plate.loads[0].kind, Load::Kind::Line);
   EXPECT_EQ(plate.loads[0].selector.kind, VertexSelector::Kind::BoundaryLoop);
@@ -393,6 +396,21 @@ const std::vector<BadCase> kBadCases = {
     {"edge_length_not_smaller_than_sphere", 9,
      R"(mesh = { generator = "sphere", radius = 0.05, edge_length = 0.05 })",
      9, {"'edge_length'", "smaller than"}},
+    {"panel_angle_above_a_turn", 9,
+     R"(mesh = { generator = "cylindrical_panel", radius = 1, height = 1, angle_degrees = 400, edge_length = 0.1 })",
+     9, {"'angle_degrees' in [shell.mesh]", "(0, 360]", "got 400"}},
+    {"panel_edge_not_below_arc", 9,
+     R"(mesh = { generator = "cylindrical_panel", radius = 1, height = 1, angle_degrees = 5, edge_length = 0.1 })",
+     9, {"'edge_length'", "smaller than the panel's arc length and height"}},
+    {"spherical_panel_without_polar_min", 9,
+     R"(mesh = { generator = "spherical_panel", radius = 1, edge_length = 0.1 })",
+     9, {"missing required key 'polar_min_degrees' in [shell.mesh]"}},
+    {"spherical_panel_max_below_min", 9,
+     R"(mesh = { generator = "spherical_panel", radius = 1, polar_min_degrees = 60, polar_max_degrees = 30, edge_length = 0.1 })",
+     9, {"'polar_max_degrees' in [shell.mesh]", "(60, 180)"}},
+    {"spherical_panel_key_of_cylinder", 9,
+     R"(mesh = { generator = "spherical_panel", radius = 1, polar_min_degrees = 10, height = 2, edge_length = 0.1 })",
+     9, {"unknown key 'height' in [shell.mesh]"}},
     {"negative_width", 9,
      R"(mesh = { generator = "sheet", width = -1, height = 1, edge_length = 0.1 })",
      9, {"'width'", "positive"}},
@@ -422,6 +440,24 @@ const std::vector<BadCase> kBadCases = {
     {"zero_scale", 8,
      "name = \"sheet\"\nplacement = { scale = 0 }",
      9, {"'scale' in [shell.placement]", "positive"}},
+    {"empty_pin_components", 12,
+     "name = \"left\"\ncomponents = []",
+     13, {"'components' in [shell.pin]", "non-empty list", "'x', 'y', 'z'"}},
+    {"unknown_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"x\", \"w\"]",
+     13, {"unknown component 'w' in 'components' in [shell.pin]", "expected one of 'x', 'y', 'z'"}},
+    {"upper_case_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"Z\"]",
+     13, {"unknown component 'Z'", "did you mean 'z'?"}},
+    {"repeated_pin_component", 12,
+     "name = \"left\"\ncomponents = [\"x\", \"y\", \"x\"]",
+     13, {"'components' in [shell.pin]", "distinct", "'x' is listed twice"}},
+    {"pin_components_not_strings", 12,
+     "name = \"left\"\ncomponents = \"x\"",
+     13, {"expected an array of strings for 'components'"}},
+    {"pin_component_misspelt_key", 12,
+     "name = \"left\"\ncomponent = [\"x\"]",
+     13, {"unknown key 'component' in [shell.pin]", "did you mean 'components'?"}},
     {"no_selector", 13,
      "",
      11, {"missing a vertex selector in [shell.pin]", "'box'", "'vertices'"}},

@@ -34,7 +34,9 @@ double unbalanced_force(const ShellSystem& system, const Eigen::VectorXd& x) {
   Eigen::VectorXd g = -system.external_force();
   for (const auto& m : system.membranes()) m.add_gradient(x, g);
   for (const auto& b : system.bendings()) b.add_gradient(x, g);
-  for (int v : system.pinned_vertex_indices()) g.segment<3>(3 * v).setZero();
+  const std::vector<bool> fixed = system.fixed_dofs();
+  for (Eigen::Index i = 0; i < g.size(); ++i)
+    if (fixed[i]) g[i] = 0.0;
   return g.lpNorm<Eigen::Infinity>();
 }
 
