@@ -27,6 +27,12 @@ struct VerificationCase {
   std::optional<double> within;
 };
 
+/// For test listings: the benchmark, the model and the mesh.
+void PrintTo(const VerificationCase& c, std::ostream* out) {
+  *out << c.benchmark << (c.bending == BendingModel::hinge ? " hinge" : " midedge") << " edge "
+       << c.edge_length;
+}
+
 /// Half a percentage point: far above the solver's effect, far below any model change.
 constexpr double kBand = 0.005;
 
