@@ -227,7 +227,7 @@ TEST(SceneOverrides, ValuesPossibleAloneButNotTogetherAreRefusedNamingBoth) {
 }
 
 TEST(SceneOverrides, EveryNumberOfEveryLibrarySceneIsAPathThatTakesItsOwnValue) {
-  for (const auto& entry : fs::directory_iterator(test::source_dir() / "jobs/scenes")) {
+  for (const auto& entry : fs::recursive_directory_iterator(test::source_dir() / "jobs/scenes")) {
     if (entry.path().extension() != ".toml") continue;
     const SceneDocument document = SceneDocument::read(entry.path());
     const auto paths = document.numeric_paths();

@@ -46,7 +46,7 @@ std::vector<BuiltShell> build(const Scene& scene) {
 TEST(ExampleScenes, EveryLibrarySceneLoadsAndSelectsVertices) {
   int scenes = 0;
   for (const auto& entry :
-       std::filesystem::directory_iterator(test::source_dir() / "jobs" / "scenes")) {
+       std::filesystem::recursive_directory_iterator(test::source_dir() / "jobs" / "scenes")) {
     if (entry.path().extension() != ".toml") continue;
     ++scenes;
     SCOPED_TRACE(entry.path().string());
