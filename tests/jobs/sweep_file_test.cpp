@@ -13,6 +13,7 @@
 #include <set>
 
 #include "engine/core/error.hpp"
+#include "engine/scene/scene_reader.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -283,15 +284,20 @@ TEST(SweepFile, AnInvalidSceneIsReportedInTheSceneFile) {
       << error_of(file);
 }
 
-TEST(SweepFile, TheDemoSweepExpandsToEightValidJobsAtTwoDepths) {
+TEST(SweepFile, TheDemoSweepIsACoarseFirstContactSweepOfNineJobs) {
   const auto sweep = read_sweep(test::source_dir() / "jobs/sweeps/demo.toml");
   EXPECT_EQ(sweep.name, "demo");
-  ASSERT_EQ(sweep.jobs.size(), 8u);
-  EXPECT_EQ(std::count_if(sweep.jobs.begin(), sweep.jobs.end(),
-                          [](const auto& job) { return job.depth == 2; }),
-            4);
-  EXPECT_EQ(jobs::new_jobs(sweep).front().scene,
-            (test::source_dir() / "jobs/scenes/demo_strip.toml").lexically_normal().string());
+  ASSERT_EQ(sweep.jobs.size(), 9u);
+  EXPECT_TRUE(std::all_of(sweep.jobs.begin(), sweep.jobs.end(),
+                          [](const auto& job) { return job.depth == 3; }));
+  EXPECT_EQ(sweep.refine.kind, db::RefineKind::top);
+  EXPECT_EQ(sweep.refine.preview_levels(3), 2);
+  const auto jobs = jobs::new_jobs(sweep);
+  EXPECT_EQ(jobs.front().scene,
+            (test::source_dir() / "jobs/scenes/drape_sphere.toml").lexically_normal().string());
+  // The scene it sweeps has contact (a collider): the demo shows what the progressive solver is
+  // for.
+  EXPECT_FALSE(read_scene(jobs.front().scene).colliders.empty());
 }
 
 TEST(SweepFile, TextIsReadAsIfItWereTheNamedFile) {
