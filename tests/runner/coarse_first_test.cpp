@@ -1,7 +1,7 @@
 // Coarse-first sweeps end to end: two `psq work` processes preview every point of a small
 // cantilever sweep, the rule promotes the points it should (checked here from the stored
 // preview outputs), those finish bit for bit as in a refine = "all" run, the others stay
-// previewed until `psq promote` selects them by hand.
+// previewed until `psq promote` selects them by hand; and the main job's sweep, a contact scene, ends so.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -161,6 +161,32 @@ TEST(CoarseFirst, TheRulePromotesItsSelectionWhichEndsAsARefineAllRunAndTheRestW
               std::string::npos)
         << line;
   }
+}
+
+TEST(CoarseFirst, TheDemoSweepRefinesTheThreeLowestHangingClothsAndPreviewsTheRest) {
+  // The main job's sweep (scripts/demo.sh): a contact scene, depth 3, the top-3 rule.
+  const test::CantileverWorkspace demo("coarse_first_demo");
+  const test::ProcessResult added =
+      demo.psq({"sweep", "add", (test::source_dir() / "jobs/sweeps/demo.toml").string()});
+  ASSERT_EQ(added.exit_code, 0) << added.errors;
+  const test::ProcessResult worked = demo.psq({"work", "--workers", "2"});
+  ASSERT_EQ(worked.exit_code, 0) << worked.errors;
+
+  const std::vector<db::JobResult> jobs = demo.results();
+  ASSERT_EQ(jobs.size(), 9u);
+  const std::set<std::string> selected = expected_top(jobs, 3);
+  for (const db::JobResult& job : jobs) {
+    SCOPED_TRACE(job.job.id);
+    const bool refined = selected.count(job.job.id) > 0;
+    EXPECT_EQ(job.job.state, refined ? db::JobState::done : db::JobState::previewed);
+    ASSERT_EQ(job.levels.size(), refined ? 3u : 2u);
+    for (const auto& level : job.levels)
+      EXPECT_EQ(level.status, db::LevelStatus::done) << "level " << level.level;
+  }
+  const test::ProcessResult report =
+      demo.psq({"report", "demo", "--out", (demo.dir / "report").string()});
+  EXPECT_EQ(report.exit_code, 0) << report.errors;
+  EXPECT_TRUE(fs::exists(demo.dir / "report" / "report.html"));
 }
 
 TEST(CoarseFirst, PromoteByHandRefinesTheChosenPreviewsFromTheirCheckpoints) {
