@@ -1,7 +1,8 @@
 // Coarse-first sweeps end to end: two `psq work` processes preview every point of a small
 // cantilever sweep, the rule promotes the points it should (checked here from the stored
 // preview outputs), those finish bit for bit as in a refine = "all" run, the others stay
-// previewed until `psq promote` selects them by hand; and the main job's sweep, a contact scene, ends so.
+// previewed until `psq promote` selects them by hand. The main job's sweep, a contact scene,
+// ends the same way.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
