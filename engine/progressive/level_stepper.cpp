@@ -19,11 +19,12 @@ FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame,
 FrameRecord LevelStepper::step(Eigen::VectorXd& x, int frame, double time_step,
                                const NewtonSolver::Progress& progress) {
   const Eigen::VectorXd previous = x;
-  return step(previous, x, frame, time_step, 0, progress);
+  return step(previous, x, frame, time_step, 0, settings_, progress);
 }
 
 FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd& x, int frame,
                                double time_step, int iterations_done,
+                               const NewtonSettings& step_settings,
                                const NewtonSolver::Progress& progress,
                                const Eigen::VectorXd& frame_start) {
   objective_->set_time_step(time_step);
@@ -31,7 +32,7 @@ FrameRecord LevelStepper::step(const Eigen::VectorXd& previous, Eigen::VectorXd&
   FrameRecord record;
   record.frame = frame;
   record.time = frame * system_.scene().time.step;
-  NewtonSettings settings = settings_;
+  NewtonSettings settings = step_settings;
   settings.max_iterations -= iterations_done;
   int taken = iterations_done;
   const NewtonSolver::Progress numbered = numbered_through_frame(progress, taken);

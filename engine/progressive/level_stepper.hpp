@@ -37,14 +37,16 @@ class LevelStepper {
   /// The same as a settling step: the inertia-like term uses `time_step` instead of Δt.
   FrameRecord step(Eigen::VectorXd& x, int frame, double time_step,
                    const NewtonSolver::Progress& progress = {});
-  /// A step from xᵗ = `previous` that already took `iterations_done` Newton iterations and
-  /// reached the iterate x: Newton continues from x with the iterations left, numbering them
+  /// A step from xᵗ = `previous` that already took `iterations_done` Newton iterations of the
+  /// budget `settings` gives (the level's settings() or another budget and tolerance for this
+  /// step) and reached the iterate x: Newton continues from x with the iterations left, numbering them
   /// (and counting them in the record) after those done, so that a step resumed from a stored
   /// iterate ends exactly where the uninterrupted one does (with contact: exactly between
   /// steps; inside one, κ and the scripted moves start again). x is overwritten with the result.
   /// Friction's slip is measured from `frame_start` (the frame's first xᵗ; empty: `previous`).
   FrameRecord step(const Eigen::VectorXd& previous, Eigen::VectorXd& x, int frame, double time_step,
-                   int iterations_done, const NewtonSolver::Progress& progress = {},
+                   int iterations_done, const NewtonSettings& settings,
+                   const NewtonSolver::Progress& progress = {},
                    const Eigen::VectorXd& frame_start = {});
 
  private:

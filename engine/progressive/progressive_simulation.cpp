@@ -39,6 +39,13 @@ constexpr const char* kStalledSteps = "progressive.stalled_steps";
 constexpr int kMaxStalledSettleSteps = 8;
 constexpr double kSettleProgress = 0.99;
 
+/// The Newton budget of a fixed-step scene's first step at the finest level, in the scene's
+/// max_iterations. That step starts from the initializer, not from the previous frame, and
+/// corrects the whole difference between the prolonged coarse answer and the fine one, which an
+/// equilibrium scene's settling spreads over several steps (twist_wrap at 2230 fine vertices:
+/// 257 iterations, where a frame of its direct solve takes up to 121).
+constexpr int kEntryStepBudgets = 5;
+
 /// The shells and colliders of `system` as named parts, for intersection listings.
 std::vector<TrianglePart> triangle_parts(const ShellSystem& system) {
   std::vector<TrianglePart> parts;
@@ -306,8 +313,11 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   const int iterations_done = std::exchange(resumed_iterations_, 0);
   if (iterations_done == 0) previous_ = x_;
   if (!out.settling && iterations_done == 0) frame_start_ = previous_;
+  NewtonSettings settings = stepper_->settings();
+  if (out.settling && !frames_are_equilibria() && finest_level())
+    settings.max_iterations *= kEntryStepBudgets;
   out.frame = stepper_->step(
-      previous_, x_, frame, time_step, iterations_done,
+      previous_, x_, frame, time_step, iterations_done, settings,
       [&](const NewtonIteration& it) {
         if (progress) progress(level_, frame, it);
       },
