@@ -103,20 +103,6 @@ std::vector<std::optional<LevelCheckpoint>> read_level_checkpoints(
   return checkpoints;
 }
 
-/// The checkpoint's Newton iterations as solves: a solve starts where the iteration count
-/// starts again or the frame changes.
-std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations) {
-  std::vector<NewtonSolve> solves;
-  for (std::size_t i = 0; i < iterations.size(); ++i) {
-    const IterationRecord& it = iterations[i];
-    if (i == 0 || it.frame != iterations[i - 1].frame ||
-        it.iteration <= iterations[i - 1].iteration)
-      solves.push_back({it.frame, {}});
-    solves.back().residuals.push_back(it.gradient_norm);
-  }
-  return solves;
-}
-
 /// The level's shells and colliders: from its part-meshes file (written beside the checkpoint
 /// by the executor) when it is there and matches, else the checkpoint's mesh as one shell.
 LevelShape level_shape(LevelCheckpoint& level, JobReport& job) {
@@ -207,6 +193,18 @@ JobReport job_report(const db::JobResult& result, int number,
 }
 
 }  // namespace
+
+std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations) {
+  std::vector<NewtonSolve> solves;
+  for (std::size_t i = 0; i < iterations.size(); ++i) {
+    const IterationRecord& it = iterations[i];
+    if (i == 0 || it.frame != iterations[i - 1].frame ||
+        it.iteration <= iterations[i - 1].iteration)
+      solves.push_back({it.frame, {}});
+    solves.back().residuals.push_back(it.gradient_norm);
+  }
+  return solves;
+}
 
 HierarchyCacheSummary summarize_cache_uses(const std::vector<db::HierarchyCacheUse>& uses) {
   HierarchyCacheSummary summary;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "db/job_records.hpp"
+#include "engine/io/checkpoint.hpp"
 #include "engine/io/part_meshes.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 
@@ -87,6 +88,12 @@ struct JobReport {
   bool finished() const { return job.state == db::JobState::done; }
   bool previewed() const { return job.state == db::JobState::previewed; }
 };
+
+/// A level's Newton iterations (as its checkpoint records them) cut into solves: a solve starts
+/// where the frame changes or the iteration count within the frame does not advance (a solve's
+/// last record takes no step, and the frame's next solve, a settling step, starts from the same
+/// count).
+std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations);
 
 /// What the shared hierarchy cache did for a sweep's jobs (db::HierarchyCacheUse, every
 /// attempt): hits and builds, their seconds, and the build time the hits saved.

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
 #include <functional>
 #include <set>
 
@@ -21,6 +20,19 @@ std::string job_label(const JobReport& job) { return fmt::format("#{}", job.numb
 /// "direct" for a one-level job, else "progressive, N levels".
 std::string method_label(const JobReport& job) {
   return job.job.depth == 1 ? "direct" : fmt::format("progressive, {} levels", job.job.depth);
+}
+
+/// Convergence plots of longer solves are drawn as lines without point markers.
+constexpr std::size_t kMaxMarkedIterations = 60;
+
+/// Convergence plots of solves up to this many iterations get one x tic per iteration.
+constexpr std::size_t kMaxIterationTics = 12;
+
+/// The most iterations of any of the solves.
+std::size_t longest_solve(const std::vector<NewtonSolve>& solves) {
+  std::size_t longest = 0;
+  for (const NewtonSolve& solve : solves) longest = std::max(longest, solve.residuals.size());
+  return longest;
 }
 
 /// The distinct frames of the solves, in order of first appearance.
@@ -43,10 +55,7 @@ bool labelled_frame(std::ptrdiff_t index, std::size_t count) {
 /// Frames in order along the displacement colour scale, stopping short of its palest end
 /// (hard to see on white).
 std::string frame_colour(std::ptrdiff_t index, std::size_t count) {
-  const double fraction = count > 1 ? 0.85 * index / (count - 1.0) : 0.0;
-  const Colour c = displacement_colour(fraction);
-  return fmt::format("#{:02x}{:02x}{:02x}", static_cast<int>(std::lround(c.red)),
-                     static_cast<int>(std::lround(c.green)), static_cast<int>(std::lround(c.blue)));
+  return hex_colour(displacement_colour(count > 1 ? 0.85 * index / (count - 1.0) : 0.0));
 }
 
 /// True if every value is positive and the largest is at least `ratio` times the smallest.
@@ -164,7 +173,11 @@ std::vector<PlotSpec> convergence_plots(const JobReport& job) {
     plot.x_label = "Newton iteration within the solve";
     plot.y_label = "residual |grad E|";
     plot.log_y = true;
-    plot.integer_x = true;
+    // A tic per iteration reads well for short solves; long ones are left to gnuplot's tics.
+    const std::size_t longest = longest_solve(level.solves);
+    plot.integer_x = longest <= kMaxIterationTics;
+    plot.style =
+        longest > kMaxMarkedIterations ? PlotSpec::Style::lines : PlotSpec::Style::linespoints;
     const std::vector<int> frames = frames_of(level.solves);
     for (std::size_t k = 0; k < level.solves.size(); ++k) {
       const NewtonSolve& solve = level.solves[k];

@@ -19,14 +19,6 @@ constexpr Colour kColliderColour{170, 176, 184};
 /// the darkest shade of a colour is not mistaken for another colour of the scale).
 constexpr double kAmbient = 0.45;
 
-std::string hex(const Colour& colour, double intensity) {
-  const auto channel = [intensity](double value) {
-    return static_cast<int>(std::clamp(std::lround(value * intensity), 0L, 255L));
-  };
-  return fmt::format("#{:02x}{:02x}{:02x}", channel(colour.red), channel(colour.green),
-                     channel(colour.blue));
-}
-
 /// One triangle to draw: its corners, its fill and whether it belongs to a collider.
 struct DrawnTriangle {
   std::array<Eigen::Vector3d, 3> corners;
@@ -41,6 +33,14 @@ Eigen::VectorXd displacements(const PartMesh& part) {
 }
 
 }  // namespace
+
+std::string hex_colour(const Colour& colour, double intensity) {
+  const auto channel = [intensity](double value) {
+    return static_cast<int>(std::clamp(std::lround(value * intensity), 0L, 255L));
+  };
+  return fmt::format("#{:02x}{:02x}{:02x}", channel(colour.red), channel(colour.green),
+                     channel(colour.blue));
+}
 
 Colour displacement_colour(double fraction) {
   // Stops of a viridis-like scale: ordered in lightness, readable in grey and by most
@@ -119,7 +119,7 @@ std::string ShapePicture::svg(const LevelShape& shape, const std::string& captio
                    : displacement_colour(largest_displacement_ > 0
                                              ? displacement / largest_displacement_
                                              : 0.0);
-      drawn.fill = hex(colour, kAmbient + (1 - kAmbient) * lambert);
+      drawn.fill = hex_colour(colour, kAmbient + (1 - kAmbient) * lambert);
       drawn.collider = collider;
       triangles.push_back(std::move(drawn));
     }
@@ -157,7 +157,7 @@ std::string ShapePicture::colour_bar(int width) const {
   for (int s = 0; s < kSteps; ++s)
     svg += fmt::format("<rect x=\"{:.2f}\" y=\"2\" width=\"{:.2f}\" height=\"{}\" fill=\"{}\"/>",
                        10 + s * step, step + 0.5, kBarHeight,
-                       hex(displacement_colour((s + 0.5) / kSteps), 1.0));
+                       hex_colour(displacement_colour((s + 0.5) / kSteps)));
   svg += fmt::format(
       "<g font-family=\"sans-serif\" font-size=\"11\" fill=\"#1b2733\">"
       "<text x=\"10\" y=\"30\">0</text>"

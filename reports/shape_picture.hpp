@@ -24,6 +24,9 @@ struct Colour {
   double red, green, blue;
 };
 
+/// "#rrggbb" of `colour` scaled by `intensity` (channels rounded and clamped to 0–255).
+std::string hex_colour(const Colour& colour, double intensity = 1.0);
+
 /// The displacement colour scale (perceptually ordered, dark blue → teal → yellow) at
 /// `fraction` ∈ [0, 1] (clamped).
 Colour displacement_colour(double fraction);

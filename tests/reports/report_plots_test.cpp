@@ -43,6 +43,32 @@ TEST(ConvergencePlots, OneCurvePerSolveTheSolvesOfAFrameShareColourAndLegendEntr
   ASSERT_EQ(plot.series[2].points.size(), 2u);
   EXPECT_EQ(plot.series[2].points[0], std::make_pair(0.0, 1e-2));
   EXPECT_EQ(plot.series[2].points[1], std::make_pair(1.0, 1e-8));
+  EXPECT_TRUE(plot.integer_x);  // short solves: a tic per iteration
+
+  job.levels[0].solves = {{1, std::vector<double>(40, 1.0)}};
+  EXPECT_FALSE(convergence_plots(job).front().integer_x);  // 40 tics would crowd the axis
+}
+
+TEST(NewtonSolves, ASettlingStepStartsANewSolveWhereTheCountRepeatsAndAFrameWhereItChanges) {
+  // As psq work records them: frame 1 is a step of 2 iterations ended by a record without a
+  // step, then a settling step continuing the frame's count; frame 2 is already at rest.
+  const auto record = [](int frame, int iteration, double residual, double step) {
+    return IterationRecord{frame, iteration, 0.0, residual, 0.0, step, 0.0};
+  };
+  const std::vector<NewtonSolve> solves = newton_solves({record(1, 0, 1e-1, 1.0),
+                                                         record(1, 1, 1e-4, 1.0),
+                                                         record(1, 2, 1e-9, 0.0),
+                                                         record(1, 2, 1e-3, 1.0),
+                                                         record(1, 3, 1e-10, 0.0),
+                                                         record(2, 0, 1e-10, 0.0)});
+  ASSERT_EQ(solves.size(), 3u);
+  EXPECT_EQ(solves[0].frame, 1);
+  EXPECT_EQ(solves[0].residuals, (std::vector<double>{1e-1, 1e-4, 1e-9}));
+  EXPECT_EQ(solves[1].frame, 1);
+  EXPECT_EQ(solves[1].residuals, (std::vector<double>{1e-3, 1e-10}));
+  EXPECT_EQ(solves[2].frame, 2);
+  EXPECT_EQ(solves[2].residuals, (std::vector<double>{1e-10}));
+  EXPECT_TRUE(newton_solves({}).empty());
 }
 
 TEST(ConvergencePlots, ManyFramesKeepAShortLegendWithTheFirstAndLastFrame) {
