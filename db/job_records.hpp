@@ -132,6 +132,16 @@ struct LevelRecord {
   double updated_at = 0;     ///< set by the store on write
 };
 
+/// How one attempt of a job obtained one mesh's decimation hierarchy through the shared
+/// hierarchy cache (engine/hierarchy/hierarchy_cache.hpp): read from the cache (a hit), or built
+/// and stored; and the seconds that took. A hit saves what a build of the same key costs.
+struct HierarchyCacheUse {
+  std::string key;  ///< the cache key, 16 hex digits
+  bool hit = false;
+  double seconds = 0;
+  std::int64_t attempt = 0;  ///< the attempt that obtained it (set by the store on write)
+};
+
 /// What adding a sweep did (or, in a dry run, would do).
 struct SweepAddition {
   std::vector<std::string> added;  ///< ids of the jobs that were new, in the sweep's order
@@ -156,10 +166,11 @@ struct SweepStatus {
   std::int64_t total() const;
 };
 
-/// A job with its level records, coarsest first.
+/// A job with its level records, coarsest first, and its attempts' hierarchy cache uses.
 struct JobResult {
   Job job;
   std::vector<LevelRecord> levels;
+  std::vector<HierarchyCacheUse> hierarchy_uses;  ///< in the order recorded
 };
 
 /// Which jobs an operation applies to.

@@ -378,6 +378,21 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
   transaction.commit();
 }
 
+void JobStore::record_hierarchy_uses(const Lease& lease,
+                                     const std::vector<HierarchyCacheUse>& uses) {
+  Transaction transaction(connection_, Transaction::Mode::immediate);
+  check_lease(lease);
+  for (std::size_t position = 0; position < uses.size(); ++position)
+    connection_
+        .prepare(
+            "REPLACE INTO hierarchy_cache_uses (job_id, attempt, position, cache_key, hit, "
+            "seconds) VALUES (?1, ?2, ?3, ?4, ?5, ?6)")
+        .bind_all(lease.job_id, lease.attempt, static_cast<std::int64_t>(position),
+                  uses[position].key, static_cast<int>(uses[position].hit), uses[position].seconds)
+        .run();
+  transaction.commit();
+}
+
 void JobStore::finish(const Lease& lease, Outcome outcome, const std::string& error) {
   Transaction transaction(connection_, Transaction::Mode::immediate);
   check_lease(lease);
@@ -607,7 +622,7 @@ std::vector<JobResult> JobStore::results(const JobSelection& which) {
   std::map<std::string, std::size_t> index_of;
   for (auto& job : jobs_where("1", which)) {
     index_of[job.id] = results.size();
-    results.push_back({std::move(job), {}});
+    results.push_back({std::move(job), {}, {}});
   }
   auto levels = connection_.prepare(fmt::format(
       "SELECT job_id, {} FROM levels WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) "
@@ -616,6 +631,14 @@ std::vector<JobResult> JobStore::results(const JobSelection& which) {
   levels.bind_all(selection_value(which));
   while (levels.step())
     results[index_of.at(levels.text(0))].levels.push_back(read_level(levels, 1));
+  auto uses = connection_.prepare(fmt::format(
+      "SELECT job_id, cache_key, hit, seconds, attempt FROM hierarchy_cache_uses WHERE job_id IN "
+      "(SELECT jobs.id FROM jobs WHERE {}) ORDER BY job_id, attempt, position",
+      selection_condition(which)));
+  uses.bind_all(selection_value(which));
+  while (uses.step())
+    results[index_of.at(uses.text(0))].hierarchy_uses.push_back(
+        {uses.text(1), uses.integer(2) != 0, uses.real(3), uses.integer(4)});
   return results;
 }
 

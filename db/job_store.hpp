@@ -87,6 +87,9 @@ class JobStore {
   /// is the attempt's progress. Throws LeaseLostError if the lease is lost,
   /// std::invalid_argument if the level is outside [0, depth).
   void record_level(const Lease& lease, const LevelRecord& level);
+  /// Stores how this attempt obtained its hierarchies (one row each, in order; an attempt
+  /// records them once). Throws LeaseLostError if the lease is lost.
+  void record_hierarchy_uses(const Lease& lease, const std::vector<HierarchyCacheUse>& uses);
   /// Ends the attempt: done, or failed with `error` (queued again while failures stay below
   /// max_attempts, unless permanent). Throws LeaseLostError if the lease is lost.
   void finish(const Lease& lease, Outcome outcome, const std::string& error = {});
@@ -112,7 +115,8 @@ class JobStore {
   SweepStatus status(const std::string& sweep);
   /// The selected jobs that have a failure message (failed ones, and ones waiting for a retry).
   std::vector<Job> failures(const JobSelection& which);
-  /// The selected jobs with their level records, in the order jobs were added.
+  /// The selected jobs with their level records and hierarchy cache uses, in the order jobs
+  /// were added.
   std::vector<JobResult> results(const JobSelection& which);
   /// The job with this id, if stored.
   std::optional<Job> find_job(const std::string& id);

@@ -171,6 +171,21 @@ ALTER TABLE sweeps ADD COLUMN refine TEXT NOT NULL DEFAULT '{"kind":"all"}';
 ALTER TABLE sweeps ADD COLUMN refine_pending INTEGER NOT NULL DEFAULT 0;
 )sql";
 
+// How each attempt obtained each of its hierarchies through the shared cache: a hit (read) or a
+// build, and how long it took, so that reports can count hits and the build time they saved.
+constexpr const char* kHierarchyCacheUses = R"sql(
+CREATE TABLE hierarchy_cache_uses (
+  job_id    TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+  attempt   INTEGER NOT NULL CHECK (attempt >= 1),
+  position  INTEGER NOT NULL CHECK (position >= 0),
+  cache_key TEXT NOT NULL,
+  hit       INTEGER NOT NULL CHECK (hit IN (0, 1)),
+  seconds   REAL NOT NULL CHECK (seconds >= 0),
+  PRIMARY KEY (job_id, attempt, position)
+) WITHOUT ROWID;
+CREATE INDEX hierarchy_cache_uses_by_key ON hierarchy_cache_uses (cache_key);
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
@@ -180,6 +195,7 @@ constexpr std::array kMigrations{
     Migration{5, "refinement statistics of each level", kRefinementStatistics},
     Migration{6, "coarse-first sweeps: previewed jobs, level outputs, refine rules", kCoarseFirst,
               true},
+    Migration{7, "hierarchy cache uses: hits, builds and their seconds", kHierarchyCacheUses},
 };
 
 constexpr const char* kVersionTable = R"sql(

@@ -113,6 +113,14 @@ class ProgressiveLevelSolver final : public LevelSolver {
   std::map<std::string, double> refinement_statistics() const override {
     return simulation_.refinement_statistics();
   }
+  std::vector<db::HierarchyCacheUse> hierarchy_cache_uses() const override {
+    std::vector<db::HierarchyCacheUse> uses;
+    for (const HierarchyCacheUse& use : simulation_.hierarchy_cache_uses())
+      uses.push_back({.key = fmt::format("{:016x}", use.key),
+                      .hit = use.outcome == HierarchyCacheOutcome::kHit,
+                      .seconds = use.seconds});
+    return uses;
+  }
   const Eigen::VectorXd& positions() const override { return simulation_.positions(); }
   const Eigen::VectorXd& previous() const override { return simulation_.previous(); }
   const TriMesh& level_rest_mesh() const override { return simulation_.level_rest_mesh(); }

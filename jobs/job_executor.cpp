@@ -142,6 +142,7 @@ class JobRun {
     try {
       scene_ = job_scene(claim_.job);
       solver_ = factory_(scene_, claim_.job.depth);
+      record_hierarchy_cache_uses();
       resume();
       while (true) {
         if (!solver_->level_done()) solve_level();  // a resumed level may be done already
@@ -250,6 +251,14 @@ class JobRun {
     if (solver_->level_count() > 1)
       log(fmt::format("level {}/{}: {} vertices", solver_->level(), solver_->level_count(),
                       solver_->level_rest_mesh().vertex_count()));
+  }
+
+  /// What the hierarchy cache did for this attempt's solver, for the reports' hits and saved
+  /// time.
+  void record_hierarchy_cache_uses() {
+    const std::vector<db::HierarchyCacheUse> uses = solver_->hierarchy_cache_uses();
+    if (!uses.empty())
+      through_store([&] { store_.record_hierarchy_uses(claim_.lease, uses); });
   }
 
   // ---- solving -------------------------------------------------------------------------------

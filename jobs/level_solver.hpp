@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "db/job_records.hpp"
 #include "engine/io/part_meshes.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 #include "engine/solver/solver_stats.hpp"
@@ -63,6 +64,11 @@ class LevelSolver {
   /// What the refinement into the current level did, by name (engine/progressive/
   /// refinement_statistics.hpp); empty at level 0, for a direct solve and after restore().
   [[nodiscard]] virtual std::map<std::string, double> refinement_statistics() const {
+    return {};
+  }
+  /// How the solver obtained its hierarchies through the hierarchy cache when it was made (for
+  /// the store); none for a direct solve or without a cache.
+  [[nodiscard]] virtual std::vector<db::HierarchyCacheUse> hierarchy_cache_uses() const {
     return {};
   }
   /// The current level's positions (3n, flat); the current iterate during step().

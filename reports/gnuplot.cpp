@@ -76,8 +76,11 @@ std::string gnuplot_script(const PlotSpec& plot, const std::filesystem::path& ou
         block += fmt::format("{:.17g} {:.17g}\n", point.first, point.second);
     if (block.empty()) continue;
     script += fmt::format("$series{} << EOD\n{}EOD\n", s, block);
-    clauses.push_back(fmt::format("$series{} using 1:2 with {} title {}", s, style_name(plot.style),
-                                  quoted(plot.series[s].title)));
+    const PlotSeries& series = plot.series[s];
+    clauses.push_back(fmt::format(
+        "$series{} using 1:2 with {}{} {}", s, style_name(plot.style),
+        series.colour.empty() ? "" : fmt::format(" lc rgb {}", quoted(series.colour)),
+        series.title.empty() ? "notitle" : "title " + quoted(series.title)));
   }
   script += "plot ";
   for (std::size_t c = 0; c < clauses.size(); ++c) script += (c ? ", \\\n     " : "") + clauses[c];

@@ -8,10 +8,13 @@
 
 namespace psq::reports {
 
-/// One curve: its legend title and its (x, y) points in drawing order.
+/// One curve: its legend title (empty: not in the legend) and its (x, y) points in drawing
+/// order; `colour` ("#rrggbb") overrides gnuplot's colour sequence, so that several curves can
+/// read as one group.
 struct PlotSeries {
   std::string title;
   std::vector<std::pair<double, double>> points;
+  std::string colour;
 };
 
 /// A 2D plot. On a logarithmic axis, points with a non-positive coordinate are left out;

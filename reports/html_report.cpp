@@ -21,7 +21,12 @@ th { background: #eef1f4; overflow-wrap: anywhere; }
 .figures { display: flex; flex-wrap: wrap; gap: 1em; }
 figure { margin: 0; }
 figure img { max-width: 100%; border: 1px solid #e1e5e9; }
-figure svg.shape { border: 1px solid #e1e5e9; }
+figure.plot img { width: 600px; }
+figure svg.shape { border: 1px solid #e1e5e9; display: block; }
+.point { border: 2px solid #e1e5e9; padding: 0.4em; max-width: 470px; font-size: 0.9em; }
+.point.selected { border: 3px solid #d0541b; background: #fff6f0; }
+.point .pictures { display: flex; gap: 0.4em; }
+.mark { font-weight: bold; color: #d0541b; }
 figcaption { font-size: 0.85em; color: #4a5866; }
 .problem { color: #b00020; }
 )";
@@ -76,9 +81,9 @@ class PlotFigures {
 
 /// Where each plot of the page is in its PlotFigures.
 struct PagePlots {
-  std::vector<std::size_t> cost;        ///< time per level, error against run time
-  std::vector<std::size_t> sweep;       ///< outputs against swept parameters
-  std::map<int, std::size_t> residual;  ///< by job number
+  std::vector<std::size_t> cost;   ///< time per level, error against run time
+  std::vector<std::size_t> sweep;  ///< outputs against the axis parameter
+  std::map<int, std::vector<std::size_t>> convergence;  ///< by job number, one per level
 };
 
 PagePlots collect_plots(const SweepReport& report, PlotFigures& plots) {
@@ -87,8 +92,9 @@ PagePlots collect_plots(const SweepReport& report, PlotFigures& plots) {
     if (has_drawable_points(plot)) page.cost.push_back(plots.add(std::move(plot)));
   for (PlotSpec& plot : sweep_plots(report)) page.sweep.push_back(plots.add(std::move(plot)));
   for (const JobReport& job : report.jobs)
-    if (PlotSpec plot = residual_plot(job); job.finished() && has_drawable_points(plot))
-      page.residual[job.number] = plots.add(std::move(plot));
+    if (job.finished())
+      for (PlotSpec& plot : convergence_plots(job))
+        page.convergence[job.number].push_back(plots.add(std::move(plot)));
   return page;
 }
 
@@ -102,9 +108,9 @@ std::string overview(const SweepReport& report) {
     counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", db::to_string(state), count);
   return fmt::format(
       "<p>Sweep file: <code>{}</code><br>Job store: <code>{}</code><br>"
-      "{} jobs: {}</p>\n",
+      "{} jobs: {}<br>{}</p>\n",
       escape_html(report.source), escape_html(report.database.string()), report.jobs.size(),
-      escape_html(counts));
+      escape_html(counts), escape_html(cache_summary_text(report.hierarchy_cache)));
 }
 
 std::string problems_section(const SweepReport& report) {
@@ -117,6 +123,72 @@ std::string problems_section(const SweepReport& report) {
   return "<h2>Problems</h2>\n<ul class=\"problem\">\n" + items + "</ul>\n";
 }
 
+/// "level 1 of 3 (preview)": which level a picture shows and what it is.
+std::string level_name(const JobReport& job, int level) {
+  // A coarse-first job's preview is its preview levels; any other job's is its coarsest level.
+  const bool preview = level < job.job.preview_levels.value_or(1);
+  const char* role = level + 1 == job.job.depth ? "final" : preview ? "preview" : "intermediate";
+  return fmt::format("level {} of {} ({})", level, job.job.depth, role);
+}
+
+/// A level's picture with its caption as a <figure>.
+std::string shape_figure(const ShapePicture& picture, const JobReport& job, int level,
+                         int width) {
+  const LevelShape& shape = *job.levels[static_cast<std::size_t>(level)].shape;
+  std::size_t triangles = 0;
+  for (const PartMesh& part : shape.parts) triangles += part.triangles.rows();
+  const std::string caption =
+      fmt::format("job #{}, {}: {} triangles", job.number, level_name(job, level), triangles);
+  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n",
+                     picture.svg(shape, caption, width), escape_html(caption));
+}
+
+/// A figure with the colour bar of `picture`'s displacement scale.
+std::string colour_bar_figure(const ShapePicture& picture) {
+  return "<figure>" + picture.colour_bar() +
+         "<figcaption>shells coloured by displacement from rest; colliders grey</figcaption>"
+         "</figure>\n";
+}
+
+/// The levels of a coarse-first job the gallery shows: its last preview level, and its finest
+/// level once refined; only those with a picture.
+std::vector<int> gallery_levels(const JobReport& job) {
+  std::vector<int> levels;
+  if (!job.job.preview_levels) return levels;
+  const auto shown = [&](int level) {
+    return level < static_cast<int>(job.levels.size()) && job.levels[level].shape;
+  };
+  if (const int preview = *job.job.preview_levels - 1; shown(preview)) levels.push_back(preview);
+  if (const int finest = job.job.depth - 1; job.finished() && shown(finest))
+    levels.push_back(finest);
+  return levels;
+}
+
+/// Every point's preview beside its refined answer (when it was refined), all on one frame and
+/// colour scale, the selected points marked.
+std::string preview_gallery(const SweepReport& report) {
+  ShapePicture picture;
+  for (const JobReport& job : report.jobs)
+    for (const int level : gallery_levels(job)) picture.include(*job.levels[level].shape);
+  std::string points;
+  for (const JobReport& job : report.jobs) {
+    std::string pictures;
+    for (const int level : gallery_levels(job)) pictures += shape_figure(picture, job, level, 220);
+    if (pictures.empty()) continue;
+    const std::string verdict =
+        !job.job.promoted ? "not selected: stopped at its preview"
+        : job.finished()  ? "<span class=\"mark\">selected</span>: refined"
+                          : "<span class=\"mark\">selected</span>: not refined yet";
+    points += fmt::format(
+        "<div class=\"point{}\"><div>#{} {}: {}</div><div class=\"pictures\">{}</div></div>\n",
+        job.job.promoted ? " selected" : "", job.number,
+        escape_html(parameter_values(job.parameters, report.swept_parameters)), verdict, pictures);
+  }
+  if (points.empty()) return {};
+  return "<h3>Every point's preview, with the refined answers of the selected ones</h3>\n" +
+         figure_row(colour_bar_figure(picture) + points);
+}
+
 std::string sweep_figures(const PagePlots& page, const PlotFigures& plots) {
   std::string html = "<h2>Convergence and cost</h2>\n";
   html += page.cost.empty() ? "<p>No finished job has timings or more than one level.</p>\n"
@@ -127,19 +199,15 @@ std::string sweep_figures(const PagePlots& page, const PlotFigures& plots) {
   return html;
 }
 
+/// The job's levels side by side, preview to final, on one frame and colour scale.
 std::string shape_figures(const JobReport& job) {
   ShapePicture picture;
   for (const LevelReport& level : job.levels)
-    if (level.shape) picture.include(level.shape->positions);
+    if (level.shape) picture.include(*level.shape);
   std::string html;
-  for (const LevelReport& level : job.levels) {
-    if (!level.shape) continue;
-    const std::string caption = fmt::format("job #{}, level {}: final shape ({} triangles)",
-                                            job.number, level.level, level.shape->triangles.rows());
-    html += fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n",
-                        picture.svg(*level.shape, caption), escape_html(caption));
-  }
-  return html;
+  for (const LevelReport& level : job.levels)
+    if (level.shape) html += shape_figure(picture, job, level.level, 320);
+  return html.empty() ? html : html + colour_bar_figure(picture);
 }
 
 std::string job_section(const JobReport& job, const PagePlots& page, const PlotFigures& plots) {
@@ -147,12 +215,14 @@ std::string job_section(const JobReport& job, const PagePlots& page, const PlotF
   for (const auto& [name, value] : job.parameters)
     parameters += fmt::format("{}<code>{}</code> = {}", parameters.empty() ? "" : "<br>",
                               escape_html(name), escape_html(cell_text(value)));
-  std::string content;
-  if (const auto residual = page.residual.find(job.number); residual != page.residual.end())
-    content = plots.figures({residual->second});
-  content += shape_figures(job);
-  return fmt::format("<h2 id=\"job-{0}\">Job #{0}</h2>\n<p>id <code>{1}</code><br>{2}</p>\n{3}",
-                     job.number, escape_html(job.job.id), parameters, figure_row(content));
+  std::string convergence;
+  if (const auto found = page.convergence.find(job.number); found != page.convergence.end())
+    convergence = figure_row(plots.figures(found->second));
+  const std::string shapes = shape_figures(job);
+  return fmt::format(
+      "<h2 id=\"job-{0}\">Job #{0}</h2>\n<p>id <code>{1}</code><br>{2}</p>\n{3}{4}",
+      job.number, escape_html(job.job.id), parameters, convergence,
+      shapes.empty() ? std::string() : figure_row(shapes));
 }
 
 }  // namespace
@@ -164,8 +234,9 @@ std::string html_report(const SweepReport& report, Gnuplot& gnuplot) {
   std::string body = overview(report);
   body += "<h2>Jobs</h2>\n" + html_table(jobs_table(report));
   if (const Table previews = preview_table(report); !previews.rows.empty())
-    body += fmt::format("<h2>Coarse-first selection</h2>\n<p>{}</p>\n{}",
-                        escape_html(db::describe(report.refine)), html_table(previews));
+    body += fmt::format("<h2>Coarse-first selection</h2>\n<p>{}</p>\n{}{}",
+                        escape_html(db::describe(report.refine)), html_table(previews),
+                        preview_gallery(report));
   body += "<h2>Levels</h2>\n" + html_table(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     body += "<h2>Refinements</h2>\n" + html_table(refinements);

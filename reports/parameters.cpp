@@ -69,4 +69,20 @@ std::string cell_text(const nlohmann::json& value) {
   return value.dump();
 }
 
+std::string short_name(const std::string& name) {
+  const auto dot = name.rfind('.');
+  return dot == std::string::npos ? name : name.substr(dot + 1);
+}
+
+std::string parameter_values(const std::map<std::string, nlohmann::json>& parameters,
+                             const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) {
+    const auto found = parameters.find(name);
+    const std::string value = found == parameters.end() ? "-" : cell_text(found->second);
+    text += fmt::format("{}{}={}", text.empty() ? "" : ", ", short_name(name), value);
+  }
+  return text;
+}
+
 }  // namespace psq::reports

@@ -22,6 +22,15 @@ std::vector<std::string> varying_parameters(
 /// A short text of `value` that reads back to the same double: "0.001", "40", "2e+09".
 std::string exact_text(double value);
 
+/// The last part of a dotted parameter name: "overrides.shell.strip.material.thickness" →
+/// "thickness".
+std::string short_name(const std::string& name);
+
+/// "thickness=0.001, youngs_modulus=2e+09": the values of `names` in `parameters` (cell_text,
+/// "-" for a missing one) by their short names.
+std::string parameter_values(const std::map<std::string, nlohmann::json>& parameters,
+                             const std::vector<std::string>& names);
+
 /// A value as a table cell: strings without quotes, integers as such, other numbers as
 /// exact_text, anything else as compact JSON; empty for a missing value.
 std::string cell_text(const nlohmann::json& value);

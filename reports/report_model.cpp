@@ -9,6 +9,7 @@
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "jobs/run_directory.hpp"
 #include "reports/level_metrics.hpp"
 #include "reports/parameters.hpp"
 
@@ -73,18 +74,25 @@ std::vector<LevelReport> levels_of(const db::JobResult& result) {
   return levels;
 }
 
-/// The checkpoints of a finished job's levels (empty where unreadable, with a problem noted).
-std::vector<std::optional<Checkpoint>> read_level_checkpoints(const db::JobResult& result,
-                                                              const std::filesystem::path& database,
-                                                              JobReport& job) {
-  std::vector<std::optional<Checkpoint>> checkpoints(job.levels.size());
+/// A level's checkpoint, read, and the file it was read from.
+struct LevelCheckpoint {
+  Checkpoint checkpoint;
+  std::filesystem::path file;
+};
+
+/// The checkpoints of the first `count` levels of a job (empty where unreadable, with a problem
+/// noted).
+std::vector<std::optional<LevelCheckpoint>> read_level_checkpoints(
+    const db::JobResult& result, const std::filesystem::path& database, std::size_t count,
+    JobReport& job) {
+  std::vector<std::optional<LevelCheckpoint>> checkpoints(count);
   for (const db::LevelRecord& record : result.levels) {
     if (record.level < 0 || record.level >= static_cast<int>(checkpoints.size())) continue;
     if (record.checkpoint_path.empty()) continue;
     const std::filesystem::path file = resolve_checkpoint(record.checkpoint_path, database);
     try {
-      checkpoints[record.level] =
-          read_checkpoint(file, recorded_checksum(record.checkpoint_checksum, file));
+      checkpoints[record.level] = LevelCheckpoint{
+          read_checkpoint(file, recorded_checksum(record.checkpoint_checksum, file)), file};
     } catch (const InputError& e) {
       job.problems.push_back(fmt::format("level {}: {}", record.level, e.what()));
     }
@@ -95,32 +103,61 @@ std::vector<std::optional<Checkpoint>> read_level_checkpoints(const db::JobResul
   return checkpoints;
 }
 
-/// Errors to the finest level, outputs and shapes of a finished job, from its checkpoints.
-void add_checkpoint_results(std::vector<std::optional<Checkpoint>>& checkpoints, JobReport& job) {
-  const std::optional<Checkpoint>& finest = checkpoints.back();
-  if (finest) {
+/// The level's shells and colliders: from its part-meshes file (written beside the checkpoint
+/// by the executor) when it is there and matches, else the checkpoint's mesh as one shell.
+LevelShape level_shape(LevelCheckpoint& level, JobReport& job) {
+  const std::filesystem::path parts_file =
+      jobs::RunDirectory(level.file.parent_path()).part_meshes(level.checkpoint.level);
+  if (std::filesystem::exists(parts_file)) {
     try {
-      job.outputs.max_displacement = max_point_distance(finest->positions, finest->rest_positions);
-    } catch (const std::invalid_argument& e) {
-      job.problems.push_back(
-          fmt::format("finest level: positions against rest shape: {}", e.what()));
+      PartMeshes meshes = read_part_meshes(parts_file);
+      Eigen::Index vertices = 0;
+      for (const PartMesh& part : meshes.parts) vertices += part.positions.rows();
+      if (vertices == level.checkpoint.positions.rows()) return {std::move(meshes.parts)};
+      job.problems.push_back(fmt::format(
+          "level {}: {} has {} vertices, its checkpoint {}; the picture shows the checkpoint",
+          level.checkpoint.level, parts_file.string(), vertices,
+          level.checkpoint.positions.rows()));
+    } catch (const InputError& e) {
+      job.problems.push_back(fmt::format("level {}: {}", level.checkpoint.level, e.what()));
     }
-    if (const auto energy = finest->solver.scalars.find(kElasticEnergyScalar);
-        energy != finest->solver.scalars.end())
-      job.outputs.elastic_energy = energy->second;
   }
+  PartMesh whole{"shells", PartKind::shell, std::move(level.checkpoint.positions),
+                 std::move(level.checkpoint.rest_positions),
+                 std::move(level.checkpoint.triangles)};
+  return {{std::move(whole)}};
+}
+
+/// Outputs of a finished job from its finest checkpoint, and every level's error to it.
+void add_finest_results(const std::vector<std::optional<LevelCheckpoint>>& checkpoints,
+                        JobReport& job) {
+  if (!checkpoints.back()) return;
+  const Checkpoint& finest = checkpoints.back()->checkpoint;
+  try {
+    job.outputs.max_displacement = max_point_distance(finest.positions, finest.rest_positions);
+  } catch (const std::invalid_argument& e) {
+    job.problems.push_back(fmt::format("finest level: positions against rest shape: {}", e.what()));
+  }
+  if (const auto energy = finest.solver.scalars.find(kElasticEnergyScalar);
+      energy != finest.solver.scalars.end())
+    job.outputs.elastic_energy = energy->second;
   for (std::size_t l = 0; l < checkpoints.size(); ++l) {
     if (!checkpoints[l]) continue;
-    if (finest) {
-      try {
-        job.levels[l].error_to_finest =
-            relative_error_to_finest(checkpoints[l]->finest_positions, finest->positions);
-      } catch (const std::invalid_argument& e) {
-        job.problems.push_back(fmt::format("level {}: error to the finest level: {}", l, e.what()));
-      }
+    try {
+      job.levels[l].error_to_finest =
+          relative_error_to_finest(checkpoints[l]->checkpoint.finest_positions, finest.positions);
+    } catch (const std::invalid_argument& e) {
+      job.problems.push_back(fmt::format("level {}: error to the finest level: {}", l, e.what()));
     }
-    job.levels[l].shape =
-        LevelShape{std::move(checkpoints[l]->positions), std::move(checkpoints[l]->triangles)};
+  }
+}
+
+/// Newton solves and shapes of the levels with a checkpoint (which they consume).
+void add_level_pictures(std::vector<std::optional<LevelCheckpoint>>& checkpoints, JobReport& job) {
+  for (std::size_t l = 0; l < checkpoints.size(); ++l) {
+    if (!checkpoints[l]) continue;
+    job.levels[l].solves = newton_solves(checkpoints[l]->checkpoint.statistics.iterations);
+    job.levels[l].shape = level_shape(*checkpoints[l], job);
   }
 }
 
@@ -140,15 +177,59 @@ JobReport job_report(const db::JobResult& result, int number,
   job.job = result.job;
   job.parameters = flatten_parameters(result.job.parameters);
   job.levels = levels_of(result);
-  if (!job.finished() || job.levels.empty()) return job;
-  job.outputs.total_seconds = total_seconds(job.levels);
-  std::vector<std::optional<Checkpoint>> checkpoints =
-      read_level_checkpoints(result, database, job);
-  add_checkpoint_results(checkpoints, job);
+  if (job.levels.empty() || !(job.finished() || job.previewed())) return job;
+  // A previewed job has only its preview levels; their shapes are shown beside the refined
+  // points', while the outputs and errors of a job are its finest level's.
+  const std::size_t shown =
+      job.finished() ? job.levels.size() : static_cast<std::size_t>(job.job.levels_to_run());
+  std::vector<std::optional<LevelCheckpoint>> checkpoints =
+      read_level_checkpoints(result, database, shown, job);
+  if (job.finished()) {
+    job.outputs.total_seconds = total_seconds(job.levels);
+    add_finest_results(checkpoints, job);
+  }
+  add_level_pictures(checkpoints, job);
   return job;
 }
 
 }  // namespace
+
+std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations) {
+  std::vector<NewtonSolve> solves;
+  for (std::size_t i = 0; i < iterations.size(); ++i) {
+    const IterationRecord& it = iterations[i];
+    if (i == 0 || it.frame != iterations[i - 1].frame ||
+        it.iteration <= iterations[i - 1].iteration)
+      solves.push_back({it.frame, {}});
+    solves.back().residuals.push_back(it.gradient_norm);
+  }
+  return solves;
+}
+
+HierarchyCacheSummary summarize_cache_uses(const std::vector<db::HierarchyCacheUse>& uses) {
+  HierarchyCacheSummary summary;
+  std::map<std::string, std::pair<double, int>> builds_of_key;  // key → (seconds, builds)
+  for (const db::HierarchyCacheUse& use : uses) {
+    if (use.hit) {
+      ++summary.hits;
+      summary.hit_seconds += use.seconds;
+    } else {
+      ++summary.builds;
+      summary.build_seconds += use.seconds;
+      builds_of_key[use.key].first += use.seconds;
+      ++builds_of_key[use.key].second;
+    }
+  }
+  for (const db::HierarchyCacheUse& use : uses) {
+    if (!use.hit) continue;
+    const auto built = builds_of_key.find(use.key);
+    if (built == builds_of_key.end())
+      ++summary.hits_without_build;
+    else
+      summary.saved_seconds += built->second.first / built->second.second - use.seconds;
+  }
+  return summary;
+}
 
 SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {
   const db::SweepStatus status = store.status(sweep);
@@ -161,12 +242,16 @@ SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {
   const std::vector<db::JobResult> results = store.results(db::JobSelection::sweep(sweep));
   std::vector<std::map<std::string, nlohmann::json>> parameter_sets;
   std::set<std::string> names;
+  std::vector<db::HierarchyCacheUse> cache_uses;
   for (std::size_t i = 0; i < results.size(); ++i) {
     report.jobs.push_back(job_report(results[i], static_cast<int>(i) + 1, report.database));
     parameter_sets.push_back(report.jobs.back().parameters);
     for (const auto& [name, value] : report.jobs.back().parameters) names.insert(name);
     report.max_depth = std::max(report.max_depth, results[i].job.depth);
+    cache_uses.insert(cache_uses.end(), results[i].hierarchy_uses.begin(),
+                      results[i].hierarchy_uses.end());
   }
+  report.hierarchy_cache = summarize_cache_uses(cache_uses);
   report.parameter_names.assign(names.begin(), names.end());
   report.swept_parameters = varying_parameters(parameter_sets);
   return report;

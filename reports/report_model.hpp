@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "db/job_records.hpp"
+#include "engine/io/checkpoint.hpp"
+#include "engine/io/part_meshes.hpp"
 #include "engine/mesh/tri_mesh.hpp"
 
 namespace psq::db {
@@ -20,10 +22,17 @@ class JobStore;
 
 namespace psq::reports {
 
-/// A level's final shape, read from its checkpoint.
+/// A level's final shape: its shells and colliders with their rest positions (for the
+/// displacement colours), from the level's part-meshes file beside its checkpoint, else the
+/// checkpoint's whole mesh as one shell.
 struct LevelShape {
-  Positions positions;  ///< n×3
-  Triangles triangles;  ///< m×3
+  std::vector<PartMesh> parts;
+};
+
+/// One Newton solve of a level: a frame's step, or one settling step at a frame.
+struct NewtonSolve {
+  int frame = 0;
+  std::vector<double> residuals;  ///< ‖∇E‖ at each iteration, from the level's checkpoint
 };
 
 /// One hierarchy level of a job.
@@ -49,9 +58,13 @@ struct LevelReport {
   std::map<std::string, double> refinement;
   /// What the level computed, as stored (db::kLevelOutputs); empty unless done.
   std::map<std::string, double> outputs;
+  /// The level's Newton solves in order, from its checkpoint (levels with a shape only).
+  std::vector<NewtonSolve> solves;
   std::string checkpoint;           ///< as recorded in the store; empty if none
   std::string error;                ///< the level's failure message, if it failed
-  std::optional<LevelShape> shape;  ///< only for levels of finished jobs with a readable checkpoint
+  /// Only for the levels of finished jobs, and the preview levels of previewed ones, with a
+  /// readable checkpoint.
+  std::optional<LevelShape> shape;
 };
 
 /// Scalar results of a finished job, from its finest level's checkpoint.
@@ -73,7 +86,30 @@ struct JobReport {
   std::vector<std::string> problems;
 
   bool finished() const { return job.state == db::JobState::done; }
+  bool previewed() const { return job.state == db::JobState::previewed; }
 };
+
+/// A level's Newton iterations (as its checkpoint records them) cut into solves: a solve starts
+/// where the frame changes or the iteration count within the frame does not advance (a solve's
+/// last record takes no step, and the frame's next solve, a settling step, starts from the same
+/// count).
+std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations);
+
+/// What the shared hierarchy cache did for a sweep's jobs (db::HierarchyCacheUse, every
+/// attempt): hits and builds, their seconds, and the build time the hits saved.
+struct HierarchyCacheSummary {
+  std::int64_t hits = 0;
+  std::int64_t builds = 0;
+  double hit_seconds = 0;    ///< reading the hits' files
+  double build_seconds = 0;  ///< building and storing
+  /// Σ over hits of (the mean seconds of the sweep's builds of the hit's key − the hit's own).
+  double saved_seconds = 0;
+  /// Hits of keys no job of the sweep built (an earlier sweep did): their saving is unknown.
+  std::int64_t hits_without_build = 0;
+};
+
+/// The summary of these cache uses (see HierarchyCacheSummary).
+HierarchyCacheSummary summarize_cache_uses(const std::vector<db::HierarchyCacheUse>& uses);
 
 /// Everything a report of one sweep shows.
 struct SweepReport {
@@ -89,6 +125,7 @@ struct SweepReport {
   /// Every flattened parameter name of any job, sorted: the table columns.
   std::vector<std::string> parameter_names;
   int max_depth = 0;  ///< the largest job depth: the number of per-level columns
+  HierarchyCacheSummary hierarchy_cache;
 };
 
 /// Reads the sweep `sweep` from `store` and every checkpoint its finished jobs recorded.

@@ -4,16 +4,59 @@
 
 #include <algorithm>
 #include <functional>
+#include <set>
 
 #include "reports/parameters.hpp"
+#include "reports/shape_picture.hpp"
 
 namespace psq::reports {
 namespace {
 
-/// Residual histories longer than this are drawn as lines without point markers.
-constexpr std::size_t kMaxMarkedPoints = 60;
+/// At most this many frames get a legend entry in a convergence plot (evenly spread).
+constexpr std::size_t kMaxLegendFrames = 10;
 
 std::string job_label(const JobReport& job) { return fmt::format("#{}", job.number); }
+
+/// "direct" for a one-level job, else "progressive, N levels".
+std::string method_label(const JobReport& job) {
+  return job.job.depth == 1 ? "direct" : fmt::format("progressive, {} levels", job.job.depth);
+}
+
+/// Convergence plots of longer solves are drawn as lines without point markers.
+constexpr std::size_t kMaxMarkedIterations = 60;
+
+/// Convergence plots of solves up to this many iterations get one x tic per iteration.
+constexpr std::size_t kMaxIterationTics = 12;
+
+/// The most iterations of any of the solves.
+std::size_t longest_solve(const std::vector<NewtonSolve>& solves) {
+  std::size_t longest = 0;
+  for (const NewtonSolve& solve : solves) longest = std::max(longest, solve.residuals.size());
+  return longest;
+}
+
+/// The distinct frames of the solves, in order of first appearance.
+std::vector<int> frames_of(const std::vector<NewtonSolve>& solves) {
+  std::vector<int> frames;
+  for (const NewtonSolve& solve : solves)
+    if (std::find(frames.begin(), frames.end(), solve.frame) == frames.end())
+      frames.push_back(solve.frame);
+  return frames;
+}
+
+/// Whether the frame at `index` of `count` gets a legend entry: all of few frames, else an
+/// evenly spread selection with the first and the last.
+bool labelled_frame(std::ptrdiff_t index, std::size_t count) {
+  if (count <= kMaxLegendFrames) return true;
+  const std::size_t stride = (count + kMaxLegendFrames - 2) / (kMaxLegendFrames - 1);
+  return index % stride == 0 || index + 1 == static_cast<std::ptrdiff_t>(count);
+}
+
+/// Frames in order along the displacement colour scale, stopping short of its palest end
+/// (hard to see on white).
+std::string frame_colour(std::ptrdiff_t index, std::size_t count) {
+  return hex_colour(displacement_colour(count > 1 ? 0.85 * index / (count - 1.0) : 0.0));
+}
 
 /// True if every value is positive and the largest is at least `ratio` times the smallest.
 bool wide_positive_range(const std::vector<double>& values, double ratio) {
@@ -22,11 +65,11 @@ bool wide_positive_range(const std::vector<double>& values, double ratio) {
   return *low > 0 && *high >= ratio * *low;
 }
 
-/// The last part of a dotted parameter name: "overrides.shell.strip.material.thickness" →
-/// "thickness".
-std::string short_name(const std::string& name) {
-  const auto dot = name.rfind('.');
-  return dot == std::string::npos ? name : name.substr(dot + 1);
+/// "poisson_ratio, youngs_modulus": the short names, comma-separated.
+std::string short_names(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + short_name(name);
+  return text;
 }
 
 struct JobOutput {
@@ -51,24 +94,51 @@ std::optional<double> numeric_parameter(const JobReport& job, const std::string&
   return found->second.get<double>();
 }
 
-/// "thickness=0.001, youngs_modulus=2e9": the swept parameters other than `axis`.
-std::string other_parameters(const SweepReport& report, const JobReport& job,
-                             const std::string& axis) {
-  std::string text;
+/// The job's value of `name` as text ("-" when absent), to compare values of any type.
+std::string value_text(const JobReport& job, const std::string& name) {
+  const auto found = job.parameters.find(name);
+  return found == job.parameters.end() ? "-" : found->second.dump();
+}
+
+/// The numeric swept parameter with the most distinct values among finished jobs; the hierarchy
+/// depth (the method, not a design parameter) only when nothing else is numeric.
+std::optional<std::string> axis_parameter(const SweepReport& report) {
+  std::optional<std::string> axis;
+  std::pair<bool, std::size_t> best{false, 0};  // (not the depth, distinct values)
   for (const std::string& name : report.swept_parameters) {
-    if (name == axis) continue;
-    const auto found = job.parameters.find(name);
-    const std::string value = found == job.parameters.end() ? "-" : cell_text(found->second);
-    text += fmt::format("{}{}={}", text.empty() ? "" : ", ", short_name(name), value);
+    std::set<double> values;
+    for (const JobReport& job : report.jobs)
+      if (const std::optional<double> x = numeric_parameter(job, name); job.finished() && x)
+        values.insert(*x);
+    const std::pair<bool, std::size_t> rank{name != "depth", values.size()};
+    if (!values.empty() && rank > best) {
+      best = rank;
+      axis = name;
+    }
   }
-  return text;
+  return axis;
+}
+
+/// Whether `name` takes one value per value of `axis` among finished jobs (zipped with it).
+bool determined_by(const SweepReport& report, const std::string& name, const std::string& axis) {
+  std::map<std::string, std::string> value_at;
+  for (const JobReport& job : report.jobs) {
+    if (!job.finished()) continue;
+    const auto [entry, added] = value_at.try_emplace(value_text(job, axis), value_text(job, name));
+    if (!added && entry->second != value_text(job, name)) return false;
+  }
+  return true;
 }
 
 std::optional<PlotSpec> sweep_plot(const SweepReport& report, const std::string& axis,
                                    const JobOutput& output) {
+  std::vector<std::string> grouping, zipped;
+  for (const std::string& name : report.swept_parameters)
+    if (name != axis) (determined_by(report, name, axis) ? zipped : grouping).push_back(name);
   PlotSpec plot;
   plot.title = fmt::format("{} against {}", output.name, short_name(axis));
   plot.x_label = axis;
+  if (!zipped.empty()) plot.x_label += " (with " + short_names(zipped) + ")";
   plot.y_label = fmt::format("{} ({})", output.name, output.unit);
   plot.style = PlotSpec::Style::linespoints;
   std::vector<double> xs, ys;
@@ -77,9 +147,9 @@ std::optional<PlotSpec> sweep_plot(const SweepReport& report, const std::string&
     const std::optional<double> x = numeric_parameter(job, axis);
     const std::optional<double> y = output.value(job.outputs);
     if (!job.finished() || !x || !y) continue;
-    const std::string group = other_parameters(report, job, axis);
+    const std::string group = parameter_values(job.parameters, grouping);
     const auto [entry, added] = curve_of_group.try_emplace(group, plot.series.size());
-    if (added) plot.series.push_back({group.empty() ? output.name : group, {}});
+    if (added) plot.series.push_back({group.empty() ? output.name : group, {}, {}});
     plot.series[entry->second].points.emplace_back(*x, *y);
     xs.push_back(*x);
     ys.push_back(*y);
@@ -93,22 +163,38 @@ std::optional<PlotSpec> sweep_plot(const SweepReport& report, const std::string&
 
 }  // namespace
 
-PlotSpec residual_plot(const JobReport& job) {
-  PlotSpec plot;
-  plot.title = fmt::format("job {}: residual against iteration", job_label(job));
-  plot.x_label = "iteration";
-  plot.y_label = "residual";
-  plot.log_y = true;
-  std::size_t longest = 0;
+std::vector<PlotSpec> convergence_plots(const JobReport& job) {
+  std::vector<PlotSpec> plots;
   for (const LevelReport& level : job.levels) {
-    PlotSeries series{fmt::format("level {}", level.level), {}};
-    for (std::size_t i = 0; i < level.residuals.size(); ++i)
-      series.points.emplace_back(static_cast<double>(i + 1), level.residuals[i]);
-    longest = std::max(longest, series.points.size());
-    plot.series.push_back(std::move(series));
+    if (level.solves.empty()) continue;
+    PlotSpec plot;
+    plot.title = fmt::format("job {}, level {}: residual in each Newton solve", job_label(job),
+                             level.level);
+    plot.x_label = "Newton iteration within the solve";
+    plot.y_label = "residual |grad E|";
+    plot.log_y = true;
+    // A tic per iteration reads well for short solves; long ones are left to gnuplot's tics.
+    const std::size_t longest = longest_solve(level.solves);
+    plot.integer_x = longest <= kMaxIterationTics;
+    plot.style =
+        longest > kMaxMarkedIterations ? PlotSpec::Style::lines : PlotSpec::Style::linespoints;
+    const std::vector<int> frames = frames_of(level.solves);
+    for (std::size_t k = 0; k < level.solves.size(); ++k) {
+      const NewtonSolve& solve = level.solves[k];
+      const auto index = std::find(frames.begin(), frames.end(), solve.frame) - frames.begin();
+      const bool first_of_frame = k == 0 || solve.frame != level.solves[k - 1].frame;
+      PlotSeries series{first_of_frame && labelled_frame(index, frames.size())
+                            ? fmt::format("frame {}", solve.frame)
+                            : std::string(),
+                        {},
+                        frame_colour(index, frames.size())};
+      for (std::size_t i = 0; i < solve.residuals.size(); ++i)
+        series.points.emplace_back(static_cast<double>(i), solve.residuals[i]);
+      plot.series.push_back(std::move(series));
+    }
+    if (has_drawable_points(plot)) plots.push_back(std::move(plot));
   }
-  plot.style = longest > kMaxMarkedPoints ? PlotSpec::Style::lines : PlotSpec::Style::linespoints;
-  return plot;
+  return plots;
 }
 
 PlotSpec time_per_level_plot(const SweepReport& report) {
@@ -120,7 +206,7 @@ PlotSpec time_per_level_plot(const SweepReport& report) {
   plot.integer_x = true;
   for (const JobReport& job : report.jobs) {
     if (!job.finished()) continue;
-    PlotSeries series{job_label(job), {}};
+    PlotSeries series{job_label(job), {}, {}};
     for (const LevelReport& level : job.levels)
       if (level.seconds) series.points.emplace_back(level.level, *level.seconds);
     plot.series.push_back(std::move(series));
@@ -137,7 +223,7 @@ PlotSpec error_against_time_plot(const SweepReport& report) {
   plot.log_y = true;
   for (const JobReport& job : report.jobs) {
     if (!job.finished()) continue;
-    PlotSeries series{job_label(job), {}};
+    PlotSeries series{fmt::format("{} ({})", job_label(job), method_label(job)), {}, {}};
     double elapsed = 0.0;
     for (const LevelReport& level : job.levels) {
       if (!level.seconds) break;
@@ -151,10 +237,11 @@ PlotSpec error_against_time_plot(const SweepReport& report) {
 
 std::vector<PlotSpec> sweep_plots(const SweepReport& report) {
   std::vector<PlotSpec> plots;
-  for (const std::string& axis : report.swept_parameters)
-    for (const JobOutput& output : job_outputs())
-      if (std::optional<PlotSpec> plot = sweep_plot(report, axis, output))
-        plots.push_back(std::move(*plot));
+  const std::optional<std::string> axis = axis_parameter(report);
+  if (!axis) return plots;
+  for (const JobOutput& output : job_outputs())
+    if (std::optional<PlotSpec> plot = sweep_plot(report, *axis, output))
+      plots.push_back(std::move(*plot));
   return plots;
 }
 

@@ -9,21 +9,27 @@
 
 namespace psq::reports {
 
-/// Residual against iteration (1-based, counted through the level's frames), log scale, one
-/// curve per level of the job.
-PlotSpec residual_plot(const JobReport& job);
+/// Per level of the job with recorded Newton solves, its convergence: the residual ‖∇E‖ against
+/// the Newton iteration within each solve (log scale), one curve per solve; the solves of one
+/// frame (its step and any settling steps) share a colour and one legend entry, frames coloured
+/// in order. Levels without solves have no plot.
+std::vector<PlotSpec> convergence_plots(const JobReport& job);
 
 /// Seconds per level against the level, log scale, one curve per finished job.
 PlotSpec time_per_level_plot(const SweepReport& report);
 
 /// Error to the finest level against the run time so far (the sum of the seconds of the
-/// levels up to and including it), log scales, one curve per finished job through its levels.
-/// The finest level's error is 0 and cannot be drawn on a log scale.
+/// levels up to and including it), log scales, one curve per finished job through its levels,
+/// labelled with its method (direct, or progressive with its depth). The finest level's error
+/// is 0 and cannot be drawn on a log scale.
 PlotSpec error_against_time_plot(const SweepReport& report);
 
-/// For each numeric swept parameter and each job output (max displacement, elastic energy,
-/// time): the output against the parameter, one curve per combination of the other swept
-/// parameters. A logarithmic axis is used where positive values span a factor of 20 or more.
+/// One plot per job output (max displacement, elastic energy, time) against the sweep's axis
+/// parameter: the numeric swept parameter with the most distinct values among finished jobs.
+/// One curve per combination of the swept parameters that vary independently of the axis;
+/// parameters zipped with it (one value per axis value) only label the axis. A logarithmic
+/// axis is used where positive values span a factor of 20 or more. No plots without a numeric
+/// swept parameter.
 std::vector<PlotSpec> sweep_plots(const SweepReport& report);
 
 }  // namespace psq::reports

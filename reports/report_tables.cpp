@@ -183,6 +183,24 @@ Table refinements_table(const SweepReport& report) {
   return table;
 }
 
+std::string cache_summary_text(const HierarchyCacheSummary& cache) {
+  if (cache.hits + cache.builds == 0)
+    return "Hierarchy cache: not used (direct solves only, or no cache use recorded)";
+  const auto counted = [](std::int64_t n, const char* noun) {
+    return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+  };
+  std::string text = fmt::format(
+      "Hierarchy cache: {} and {} ({} s building); the hits read their hierarchies in {} s and "
+      "saved {} s of building",
+      counted(cache.hits, "hit"), counted(cache.builds, "build"),
+      readable_number(cache.build_seconds), readable_number(cache.hit_seconds),
+      readable_number(cache.saved_seconds));
+  if (cache.hits_without_build > 0)
+    text += fmt::format(" ({} hits of hierarchies built outside this sweep are not counted)",
+                        cache.hits_without_build);
+  return text;
+}
+
 std::string to_csv(const Table& table) {
   const auto field = [](const std::string& text) {
     if (text.find_first_of(",\"\r\n") == std::string::npos) return text;

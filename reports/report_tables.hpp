@@ -40,6 +40,10 @@ Table refinements_table(const SweepReport& report);
 /// and of the finest level. No rows for an ordinary sweep (refine = "all").
 Table preview_table(const SweepReport& report);
 
+/// The hierarchy cache in one sentence: hits, builds, their seconds and the time the hits saved
+/// (docs/reports.md).
+std::string cache_summary_text(const HierarchyCacheSummary& cache);
+
 /// RFC 4180 CSV: fields with a comma, quote or line break are quoted, quotes doubled; lines
 /// end with CRLF.
 std::string to_csv(const Table& table);

@@ -62,6 +62,13 @@ nlohmann::json results_json(const SweepReport& report) {
           {"database", report.database.string()},
           {"counts", counts},
           {"swept_parameters", report.swept_parameters},
+          {"hierarchy_cache",
+           {{"hits", report.hierarchy_cache.hits},
+            {"builds", report.hierarchy_cache.builds},
+            {"hit_seconds", report.hierarchy_cache.hit_seconds},
+            {"build_seconds", report.hierarchy_cache.build_seconds},
+            {"saved_seconds", report.hierarchy_cache.saved_seconds},
+            {"hits_without_build", report.hierarchy_cache.hits_without_build}}},
           {"jobs", jobs}};
 }
 

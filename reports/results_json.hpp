@@ -8,6 +8,8 @@
 namespace psq::reports {
 
 /// {"sweep", "source", "database", "counts": {state: n}, "swept_parameters": [...],
+///  "hierarchy_cache": {"hits", "builds", "hit_seconds", "build_seconds", "saved_seconds",
+///  "hits_without_build"},
 ///  "jobs": [{"number", "id", "parameters" (as stored), "flat_parameters", "state", "attempts",
 ///  "failures", "error", "outputs": {"total_seconds", "max_displacement", "elastic_energy"},
 ///  "problems": [...], "levels": [{"level", "status", "iterations", "seconds", "timings",

@@ -13,6 +13,7 @@ std::string summary_markdown(const SweepReport& report) {
   for (const auto& [state, count] : report.counts)
     counts.rows.push_back({std::string(db::to_string(state)), std::to_string(count)});
   text += to_markdown(counts);
+  text += "\n" + cache_summary_text(report.hierarchy_cache) + "\n";
   text += "\n## Jobs\n\n" + to_markdown(jobs_table(report));
   if (const Table previews = preview_table(report); !previews.rows.empty())
     text += fmt::format("\n## Coarse-first selection\n\n{}\n\n{}", db::describe(report.refine),

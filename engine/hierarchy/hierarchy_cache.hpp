@@ -24,6 +24,15 @@ enum class HierarchyCacheOutcome {
   kRebuilt,  ///< a file was there but unusable (damaged, truncated, foreign): rebuilt
 };
 
+/// One hierarchy obtained through the cache: what the cache did and how long it took (reading
+/// the file on a hit; building and storing it otherwise), so that a job store can account the
+/// time its hits saved.
+struct HierarchyCacheUse {
+  std::uint64_t key = 0;
+  HierarchyCacheOutcome outcome = HierarchyCacheOutcome::kBuilt;
+  double seconds = 0.0;
+};
+
 /// 64-bit key of everything the hierarchy depends on: finest positions and triangles, pins
 /// (empty = all free), settings, the decimation bounds and kHierarchyCacheVersion.
 std::uint64_t hierarchy_cache_key(const TriMesh& finest, const std::vector<int>& pin_group,

@@ -1,10 +1,30 @@
+#include <chrono>
+
 #include "engine/hierarchy/hierarchy_cache.hpp"
 #include "engine/progressive/progressive_simulation.hpp"
 
 namespace psq {
+namespace {
+
+/// load_or_build_hierarchy, timed, its cache use appended to `uses` when given.
+MeshHierarchy load_or_build_timed(const TriMesh& mesh, const std::vector<int>& pin_group,
+                                  const HierarchySettings& rules,
+                                  const std::filesystem::path& cache_dir,
+                                  std::vector<HierarchyCacheUse>* uses) {
+  const auto start = std::chrono::steady_clock::now();
+  HierarchyCacheUse use;
+  use.key = hierarchy_cache_key(mesh, pin_group, rules);
+  MeshHierarchy hierarchy = load_or_build_hierarchy(mesh, pin_group, rules, cache_dir, &use.outcome);
+  use.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (uses) uses->push_back(use);
+  return hierarchy;
+}
+
+}  // namespace
 
 std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
-                                             const ProgressiveSettings& settings) {
+                                             const ProgressiveSettings& settings,
+                                             std::vector<HierarchyCacheUse>* uses) {
   HierarchySettings hierarchy;
   hierarchy.levels = settings.schedule.levels;
   hierarchy.vertex_ratio = settings.schedule.vertex_ratio;
@@ -12,7 +32,7 @@ std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
                          const HierarchySettings& rules) {
     return settings.cache_dir.empty()
                ? build_hierarchy(mesh, pin_group, rules)
-               : load_or_build_hierarchy(mesh, pin_group, rules, settings.cache_dir);
+               : load_or_build_timed(mesh, pin_group, rules, settings.cache_dir, uses);
   };
   std::vector<MeshHierarchy> out;
   for (int s = 0; s < static_cast<int>(finest.shells().size()); ++s)

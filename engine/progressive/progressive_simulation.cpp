@@ -95,7 +95,8 @@ ProgressiveSimulation::ProgressiveSimulation(const Scene& scene,
                                              const ProgressiveSettings& settings)
     : settings_(settings), finest_(scene) {
   check_settings(scene, settings_);
-  if (settings_.schedule.levels > 1) hierarchies_ = build_hierarchies(finest_, settings_);
+  if (settings_.schedule.levels > 1)
+    hierarchies_ = build_hierarchies(finest_, settings_, &cache_uses_);
   initialize();
 }
 

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/hierarchy/hierarchy_cache.hpp"
 #include "engine/hierarchy/mesh_hierarchy.hpp"
 #include "engine/progressive/level_stepper.hpp"
 #include "engine/progressive/proxy_objective.hpp"
@@ -54,9 +55,11 @@ struct ProgressiveSettings {
 /// One hierarchy per shell of `finest` (its meshes and pin groups), then one per collider
 /// (paper §4.6: collision objects are decimated, prolonged and coloured like shells), built
 /// with the schedule's levels and vertex ratio, through the cache in settings.cache_dir when
-/// that is set. A collider that cannot be decimated as far has fewer levels.
+/// that is set. A collider that cannot be decimated as far has fewer levels. With a cache, each
+/// hierarchy's cache use is appended to `uses` (when given), in the order built.
 std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
-                                             const ProgressiveSettings& settings);
+                                             const ProgressiveSettings& settings,
+                                             std::vector<HierarchyCacheUse>* uses = nullptr);
 
 /// One step of a progressive solve.
 struct ProgressiveStep {
@@ -123,6 +126,11 @@ class ProgressiveSimulation {
   [[nodiscard]] const ShellSystem& level_system() const;
   [[nodiscard]] const TriMesh& level_rest_mesh() const { return level_system().rest_mesh(); }
   [[nodiscard]] const std::vector<MeshHierarchy>& hierarchies() const { return hierarchies_; }
+  /// What the hierarchy cache did for each hierarchy this simulation built (empty without a
+  /// cache, or when the hierarchies were given).
+  [[nodiscard]] const std::vector<HierarchyCacheUse>& hierarchy_cache_uses() const {
+    return cache_uses_;
+  }
   /// What each refinement's safe initialization did (contact scenes; in refinement order).
   [[nodiscard]] const std::vector<RefinementStats>& refinements() const { return refinements_; }
   /// What each refinement's strain-limit correction did (scenes with a strain limit; in
@@ -209,6 +217,7 @@ class ProgressiveSimulation {
   ShellSystem finest_;
   /// The shells' hierarchies, then the colliders' (if they have any).
   std::vector<MeshHierarchy> hierarchies_;
+  std::vector<HierarchyCacheUse> cache_uses_;
   int level_count_ = 1;
   int refine_frame_ = 1;
   double finest_tolerance_ = 0.0;

@@ -473,6 +473,34 @@ TEST(JobStoreResults, LevelRecordsRoundTripAndLaterAttemptsReplaceThem) {
   EXPECT_EQ(levels[1].attempt, 2);
 }
 
+TEST(JobStoreResults, HierarchyCacheUsesAreKeptPerAttemptInOrderAndFenced) {
+  JobStore store(fresh_store_path());
+  store.add_sweep("s", "s.toml", thickness_jobs(0, 1));
+  const auto first = store.claim_next(worker("a"), 30);
+  ASSERT_TRUE(first);
+  store.record_hierarchy_uses(first->lease, {{"000000000000000a", false, 4.0},
+                                             {"000000000000000b", false, 1.0}});
+  ASSERT_TRUE(store.release(first->lease));
+  const auto second = store.claim_next(worker("b"), 30);
+  ASSERT_TRUE(second);
+  store.record_hierarchy_uses(second->lease, {{"000000000000000a", true, 0.5}});
+  // The first attempt no longer holds the lease: its late write changes nothing.
+  EXPECT_THROW(store.record_hierarchy_uses(first->lease, {{"000000000000000c", true, 0.1}}),
+               LeaseLostError);
+
+  const std::vector<HierarchyCacheUse> uses =
+      store.results(JobSelection::all()).front().hierarchy_uses;
+  ASSERT_EQ(uses.size(), 3u);
+  EXPECT_EQ(uses[0].key, "000000000000000a");
+  EXPECT_FALSE(uses[0].hit);
+  EXPECT_EQ(uses[0].seconds, 4.0);
+  EXPECT_EQ(uses[0].attempt, first->lease.attempt);
+  EXPECT_EQ(uses[1].key, "000000000000000b");
+  EXPECT_TRUE(uses[2].hit);
+  EXPECT_EQ(uses[2].seconds, 0.5);
+  EXPECT_EQ(uses[2].attempt, second->lease.attempt);
+}
+
 TEST(JobStoreResults, NonFiniteResidualsSurviveAsNaN) {
   ManualClock clock;
   JobStore store(fresh_store_path(), clock.options());

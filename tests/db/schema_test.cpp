@@ -101,6 +101,41 @@ constexpr const char* kVersionSixColumns =
     "ALTER TABLE levels DROP COLUMN outputs; ALTER TABLE sweeps DROP COLUMN refine; "
     "ALTER TABLE sweeps DROP COLUMN refine_pending; ";
 
+/// Drops what version 7 added (the hierarchy cache uses), leaving what a version-6 store holds.
+constexpr const char* kVersionSevenTables = "DROP TABLE hierarchy_cache_uses; ";
+
+TEST(JobStoreSchema, AVersionSixStoreGainsHierarchyCacheUsesKeepingItsJobs) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    store.add_sweep("s", "s.toml", test::thickness_jobs(0, 2));
+  }
+  {
+    SqliteConnection raw(path, 1000);
+    raw.execute(std::string(kVersionSevenTables) + "DELETE FROM schema_version WHERE version > 6");
+    ASSERT_EQ(schema_version(raw), 6);
+    ASSERT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sqlite_schema WHERE name = "
+                                  "'hierarchy_cache_uses'"),
+              0);
+  }
+  JobStore upgraded(path);
+  EXPECT_EQ(upgraded.status("s").total(), 2);
+  const auto claim = upgraded.claim_next(test::worker("w"), 30);
+  ASSERT_TRUE(claim);
+  upgraded.record_hierarchy_uses(claim->lease, {{"00000000000000ab", false, 2.5},
+                                                {"00000000000000cd", true, 0.125}});
+  const std::vector<JobResult> results = upgraded.results(JobSelection::job(claim->job.id));
+  ASSERT_EQ(results.front().hierarchy_uses.size(), 2u);
+  EXPECT_EQ(results.front().hierarchy_uses[1].key, "00000000000000cd");
+  EXPECT_TRUE(results.front().hierarchy_uses[1].hit);
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  // A negative time is refused by the table itself.
+  EXPECT_THROW(raw.execute("INSERT INTO hierarchy_cache_uses VALUES ('" + claim->job.id +
+                           "', 1, 9, 'k', 0, -1.0)"),
+               DatabaseError);
+}
+
 TEST(JobStoreSchema, AVersionFiveStoreIsRebuiltKeepingJobsLevelsAndLinks) {
   const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
   {
@@ -115,7 +150,8 @@ TEST(JobStoreSchema, AVersionFiveStoreIsRebuiltKeepingJobsLevelsAndLinks) {
   }
   {
     SqliteConnection raw(path, 1000);
-    raw.execute(std::string(kVersionSixColumns) + "DELETE FROM schema_version WHERE version > 5");
+    raw.execute(std::string(kVersionSevenTables) + kVersionSixColumns +
+                "DELETE FROM schema_version WHERE version > 5");
     ASSERT_EQ(schema_version(raw), 5);
   }
   JobStore upgraded(path);
@@ -143,7 +179,7 @@ TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
     // Back to what a store written by a version-3 psq holds.
     SqliteConnection raw(path, 1000);
     raw.execute(
-        std::string(kVersionSixColumns) +
+        std::string(kVersionSevenTables) + kVersionSixColumns +
         "ALTER TABLE jobs DROP COLUMN progress_attempt; ALTER TABLE jobs DROP COLUMN stalls; "
         "ALTER TABLE levels DROP COLUMN refinement; DELETE FROM schema_version WHERE version > 3");
     ASSERT_EQ(schema_version(raw), 3);

@@ -18,8 +18,8 @@ PlotSpec two_curves() {
   plot.x_label = "iteration";
   plot.y_label = "residual";
   plot.log_y = true;
-  plot.series = {{"level 0", {{1, 1.0}, {2, 0.1}, {3, 0.0}, {4, NAN}, {5, 1e-7}}},
-                 {"level_1", {{1, -1.0}}}};
+  plot.series = {{"level 0", {{1, 1.0}, {2, 0.1}, {3, 0.0}, {4, NAN}, {5, 1e-7}}, {}},
+                 {"level_1", {{1, -1.0}}, {}}};
   return plot;
 }
 
@@ -39,9 +39,23 @@ TEST(Gnuplot, ScriptQuotesTextAndLeavesOutUndrawablePoints) {
   EXPECT_NE(script.find("title 'level 0'"), std::string::npos);
 }
 
+TEST(Gnuplot, SeriesWithAColourUseItAndUntitledOnesStayOutOfTheLegend) {
+  PlotSpec plot = two_curves();
+  plot.series = {{"frame 1", {{0, 1.0}}, "#3b528b"}, {"", {{0, 0.5}}, "#3b528b"}};
+  const std::string script = gnuplot_script(plot, "p.svg");
+  EXPECT_NE(script.find("$series0 using 1:2 with linespoints lw 1.5 pt 7 ps 0.6 lc rgb '#3b528b' "
+                        "title 'frame 1'"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("$series1 using 1:2 with linespoints lw 1.5 pt 7 ps 0.6 lc rgb '#3b528b' "
+                        "notitle"),
+            std::string::npos)
+      << script;
+}
+
 TEST(Gnuplot, DrawablePointsDependOnTheAxes) {
   PlotSpec plot = two_curves();
-  plot.series = {{"negative", {{1, -1.0}}}};
+  plot.series = {{"negative", {{1, -1.0}}, {}}};
   EXPECT_FALSE(has_drawable_points(plot));
   plot.log_y = false;
   EXPECT_TRUE(has_drawable_points(plot));

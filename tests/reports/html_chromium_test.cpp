@@ -2,6 +2,7 @@
 // scripts/setup.sh) loads the page from disk with no network, every plot image decodes, every
 // shape picture is there, and a screenshot of the page is a real picture.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -18,6 +19,8 @@ namespace psq::reports {
 namespace {
 
 constexpr const char* kChromium = "/usr/bin/chromium";
+/// Tall enough for the whole fixture page: the screenshot shows every plot and picture.
+constexpr int kWindowHeight = 7000;
 
 /// Runs headless Chromium (at most a minute) with a private profile.
 test::ProcessResult chromium(const std::filesystem::path& profile,
@@ -67,6 +70,20 @@ window.addEventListener('load', () => {
     colours.add((pixels[i] << 16) | (pixels[i + 1] << 8) | pixels[i + 2]);
   body.dataset.screenshotWidth = canvas.width;
   body.dataset.colours = colours.size;
+  // The first shape picture's region of the screenshot (the page is not scrolled, one CSS
+  // pixel per screenshot pixel): its distinct colours and its pixels that are not white.
+  const box = document.querySelector('svg.shape').getBoundingClientRect();
+  const region = context.getImageData(Math.round(box.left), Math.round(box.top),
+                                      Math.round(box.width), Math.round(box.height)).data;
+  const pictureColours = new Set();
+  let drawn = 0;
+  for (let i = 0; i < region.length; i += 4) {
+    pictureColours.add((region[i] << 16) | (region[i + 1] << 8) | region[i + 2]);
+    if (region[i] < 240 || region[i + 1] < 240 || region[i + 2] < 240) ++drawn;
+  }
+  body.dataset.pictureColours = pictureColours.size;
+  body.dataset.pictureDrawnPercent = Math.round(100 * drawn / (region.length / 4));
+  body.dataset.pictureBottom = Math.round(box.bottom);
 });
 </script>
 )";
@@ -82,9 +99,10 @@ TEST(HtmlReportInChromium, ShowsEveryPlotAndPictureAndScreenshotsAsARealPage) {
   const ReportOutcome outcome = write_report({database, "plates", dir / "report", "gnuplot"});
 
   const auto screenshot = dir / "report.png";
-  const auto shot =
-      chromium(dir / "profile", {"--screenshot=" + screenshot.string(), "--window-size=1280,2400",
-                                 "file://" + outcome.page.string()});
+  const auto shot = chromium(dir / "profile",
+                             {"--screenshot=" + screenshot.string(),
+                              fmt::format("--window-size=1280,{}", kWindowHeight),
+                              "file://" + outcome.page.string()});
   ASSERT_EQ(shot.exit_code, 0) << shot.errors;
   ASSERT_TRUE(std::filesystem::exists(screenshot)) << shot.errors;
   EXPECT_GT(std::filesystem::file_size(screenshot), 50'000u);  // a blank page is a few kB
@@ -95,14 +113,22 @@ TEST(HtmlReportInChromium, ShowsEveryPlotAndPictureAndScreenshotsAsARealPage) {
   const auto dump = chromium(
       dir / "profile", {"--dump-dom", "--virtual-time-budget=10000", "file://" + probe.string()});
   ASSERT_EQ(dump.exit_code, 0) << dump.errors;
-  // The same counts as the page's source (report_writer_test): 15 plots, 5 pictures of 8-,
-  // 32- and 128-triangle levels (job 1), 8 (job 2, level 0) and 8 (job 3).
-  EXPECT_EQ(dom_number(dump.output, "images"), 15);
-  EXPECT_EQ(dom_number(dump.output, "decoded"), 15);
+  // The same counts as the page's source (report_writer_test): 10 plots, 5 pictures of 8-,
+  // 32- and 128-triangle levels (job 1), 8 (job 2, level 0) and 8 plus a 2-triangle collider
+  // (job 3).
+  EXPECT_EQ(dom_number(dump.output, "images"), 10);
+  EXPECT_EQ(dom_number(dump.output, "decoded"), 10);
   EXPECT_EQ(dom_number(dump.output, "shapes"), 5);
-  EXPECT_EQ(dom_number(dump.output, "polygons"), 8 + 32 + 128 + 8 + 8);
+  EXPECT_EQ(dom_number(dump.output, "polygons"),
+            8 + 32 + 128 + 8 + 8 + test::kColliderTriangles);
   EXPECT_EQ(dom_number(dump.output, "screenshot-width"), 1280);
   EXPECT_GT(dom_number(dump.output, "colours"), 50);  // plots, shading, text: not one colour
+  // The first picture (job 1, level 0: a bent 8-triangle plate) lies inside the screenshot and
+  // is a shaded, coloured shape, not a blank or one-colour box.
+  ASSERT_GT(dom_number(dump.output, "picture-bottom"), 0);
+  ASSERT_LE(dom_number(dump.output, "picture-bottom"), kWindowHeight);
+  EXPECT_GT(dom_number(dump.output, "picture-colours"), 8);
+  EXPECT_GT(dom_number(dump.output, "picture-drawn-percent"), 15);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "engine/io/part_meshes.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq::test {
@@ -52,6 +53,9 @@ struct FixtureJob {
   double bend = 0;  ///< a
   std::optional<double> elastic_energy;
   std::vector<FixtureLevel> levels;  ///< recorded levels; the job's depth is their count
+  /// With a collider below the plate (add_collider), and part-meshes files beside its
+  /// checkpoints as the executor writes them.
+  bool collider = false;
   int depth() const { return static_cast<int>(levels.size()); }
   nlohmann::json parameters() const {
     return {{"depth", depth()},
@@ -73,7 +77,7 @@ inline std::vector<double> newton_history(int frames, double start) {
 /// The six jobs of the sweep "plates", in the order they are added.
 inline std::vector<FixtureJob> fixture_jobs() {
   std::vector<FixtureJob> jobs(6);
-  jobs[0] = {"00000000000000a1", 1e-3, 1e6, db::JobState::done, "", 0.2, 0.125, {}};
+  jobs[0] = {"00000000000000a1", 1e-3, 1e6, db::JobState::done, "", 0.2, 0.125, {}, false};
   jobs[0].levels = {
       {db::LevelStatus::done,
        newton_history(2, 1.0),
@@ -99,7 +103,7 @@ inline std::vector<FixtureJob> fixture_jobs() {
   };
   // A diverged iteration in the middle: stored as null, skipped when drawn.
   jobs[0].levels[2].residuals.insert(jobs[0].levels[2].residuals.begin() + 2, NAN);
-  jobs[1] = {"00000000000000b2", 2e-3, 1e6, db::JobState::done, "", 0.1, std::nullopt, {}};
+  jobs[1] = {"00000000000000b2", 2e-3, 1e6, db::JobState::done, "", 0.1, std::nullopt, {}, false};
   jobs[1].levels = {
       {db::LevelStatus::done,
        newton_history(3, 2.0),
@@ -116,7 +120,7 @@ inline std::vector<FixtureJob> fixture_jobs() {
        CheckpointCase::corrupted,
        ""},
   };
-  jobs[2] = {"00000000000000c3", 1e-3, 1e7, db::JobState::done, "", 0.05, 0.5, {}};
+  jobs[2] = {"00000000000000c3", 1e-3, 1e7, db::JobState::done, "", 0.05, 0.5, {}, true};
   jobs[2].levels = {{db::LevelStatus::done,
                      newton_history(4, 0.8),
                      {{"wall", 0.75}},
@@ -125,7 +129,7 @@ inline std::vector<FixtureJob> fixture_jobs() {
                      CheckpointCase::workspace_relative,
                      ""}};
   jobs[3] = {"00000000000000d4",           2e-3, 1e7,          db::JobState::failed,
-             "Newton diverged at frame 3", 0.1,  std::nullopt, {}};
+             "Newton diverged at frame 3", 0.1,  std::nullopt, {}, false};
   jobs[3].levels = {
       {db::LevelStatus::done,
        newton_history(1, 1.0),
@@ -142,7 +146,7 @@ inline std::vector<FixtureJob> fixture_jobs() {
        CheckpointCase::absolute_path,
        "Newton diverged at frame 3"},
   };
-  jobs[4] = {"00000000000000e5", 4e-3, 1e7, db::JobState::done, "", 0.1, std::nullopt, {}};
+  jobs[4] = {"00000000000000e5", 4e-3, 1e7, db::JobState::done, "", 0.1, std::nullopt, {}, false};
   jobs[4].levels = {{db::LevelStatus::done,
                      newton_history(1, 1.0),
                      {{"wall", 0.4}},
@@ -150,7 +154,7 @@ inline std::vector<FixtureJob> fixture_jobs() {
                      0.0,
                      CheckpointCase::missing,
                      ""}};
-  jobs[5] = {"00000000000000f6", 4e-3, 1e6, db::JobState::queued, "", 0.1, std::nullopt, {}};
+  jobs[5] = {"00000000000000f6", 4e-3, 1e6, db::JobState::queued, "", 0.1, std::nullopt, {}, false};
   jobs[5].levels = {FixtureLevel{}};
   return jobs;
 }
@@ -182,6 +186,36 @@ inline void fill_grid(int l, int depth, double bend, double lift, Checkpoint& c)
   c.finest_positions(0, 2) += lift;
 }
 
+/// The fixture's collider: a horizontal unit square of 2 triangles at z = −1, below the plate,
+/// appended to the checkpoint's mesh.
+inline constexpr int kColliderVertices = 4;
+inline constexpr int kColliderTriangles = 2;
+inline void add_collider(Checkpoint& c) {
+  const Eigen::Index n = c.positions.rows(), m = c.triangles.rows();
+  Positions square(kColliderVertices, 3);
+  square << 0, 0, -1, 1, 0, -1, 1, 1, -1, 0, 1, -1;
+  const auto append = [&](Positions& points) {
+    points.conservativeResize(n + kColliderVertices, 3);
+    points.bottomRows(kColliderVertices) = square;
+  };
+  append(c.positions);
+  append(c.rest_positions);
+  append(c.finest_positions);
+  append(c.solver.previous_positions);
+  c.triangles.conservativeResize(m + kColliderTriangles, 3);
+  c.triangles.bottomRows(kColliderTriangles) << n, n + 1, n + 2, n, n + 2, n + 3;
+}
+
+/// The part ranges of a fixture checkpoint: the plate, then the collider if it has one.
+inline std::vector<PartRange> fixture_parts(const Checkpoint& c, bool collider) {
+  const int n = static_cast<int>(c.positions.rows()) - (collider ? kColliderVertices : 0);
+  const int m = static_cast<int>(c.triangles.rows()) - (collider ? kColliderTriangles : 0);
+  std::vector<PartRange> parts{{"plate", PartKind::shell, 0, n, 0, m}};
+  if (collider)
+    parts.push_back({"floor", PartKind::collider, n, kColliderVertices, m, kColliderTriangles});
+  return parts;
+}
+
 inline Checkpoint fixture_checkpoint(const FixtureJob& job, int l) {
   Checkpoint c;
   c.code_version = "0.1.0-test";
@@ -194,11 +228,32 @@ inline Checkpoint fixture_checkpoint(const FixtureJob& job, int l) {
   c.solver.previous_positions = c.positions;
   if (job.elastic_energy && l + 1 == job.depth())
     c.solver.scalars["elastic_energy"] = *job.elastic_energy;
-  int iteration = 0;
-  for (double r : job.levels[l].residuals)
-    if (std::isfinite(r)) c.statistics.iterations.push_back({4, iteration++, 1.0, r, r, 1.0, 0.01});
+  // Frame f's Newton solve is the f-th falling run of the history (newton_history starts
+  // each frame high again); its iterations count from 0.
+  int frame = 1, iteration = 0;
+  double last = INFINITY;
+  for (double r : job.levels[l].residuals) {
+    if (!std::isfinite(r)) continue;
+    if (r > last) ++frame, iteration = 0;
+    c.statistics.iterations.push_back({frame, iteration++, 1.0, r, r, 1.0, 0.01});
+    last = r;
+  }
   c.statistics.timings = job.levels[l].timings;
+  if (job.collider) add_collider(c);
   return c;
+}
+
+/// The checkpoint's plate and collider as the executor writes them: `level_<l>.parts.h5` beside
+/// the checkpoint.
+inline void write_fixture_parts(const Checkpoint& c, const FixtureJob& job,
+                                const std::filesystem::path& checkpoint_file) {
+  TriMesh rest;
+  rest.vertices = c.rest_positions;
+  rest.triangles = c.triangles;
+  PartMeshes meshes{c.level, c.frame, c.time,
+                    split_into_parts(c.positions, rest, fixture_parts(c, job.collider))};
+  write_part_meshes(
+      checkpoint_file.parent_path() / fmt::format("level_{}.parts.h5", c.level), meshes);
 }
 
 /// A store `<dir>/.psq/psq.db` with the sweep "plates" of fixture_jobs() run as described,
@@ -232,7 +287,9 @@ inline std::filesystem::path make_report_fixture(const std::filesystem::path& di
         std::uint64_t checksum = 0x1234;
         if (level.checkpoint != CheckpointCase::missing) {
           std::filesystem::create_directories(file.parent_path());
-          checksum = write_checkpoint(file, fixture_checkpoint(job, l));
+          const Checkpoint checkpoint = fixture_checkpoint(job, l);
+          checksum = write_checkpoint(file, checkpoint);
+          if (job.collider) write_fixture_parts(checkpoint, job, file);
         }
         const bool relative_path = level.checkpoint == CheckpointCase::workspace_relative ||
                                    level.checkpoint == CheckpointCase::corrupted;

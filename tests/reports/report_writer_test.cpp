@@ -208,12 +208,22 @@ TEST_F(ReportWriter, MarkdownSummaryHasTheTablesAndTheProblems) {
 
 TEST_F(ReportWriter, HtmlHasEveryPlotAndPictureAndNoNetworkReference) {
   const std::string html = test::read_file(dir_ / "report" / "report.html");
-  // Plots: time per level, error against run time, 3 swept parameters × 3 outputs, and the
-  // residual plots of the 4 finished jobs. Pictures: the levels with a readable checkpoint of
-  // finished jobs: 3 (job 1) + 1 (job 2, level 0) + 1 (job 3).
-  EXPECT_EQ(count(html, "<img "), 1u + 1u + 9u + 4u);
-  EXPECT_EQ(count(html, "src=\"data:image/svg+xml;base64,"), 15u);
+  // Plots: time per level, error against run time, the 3 outputs against the thickness (the
+  // swept parameter with the most values among finished jobs), and one convergence plot per
+  // level with a readable checkpoint of a finished job: 3 (job 1) + 1 (job 2, level 0) + 1
+  // (job 3). Pictures: those 5 levels, each job's with one colour bar; job 3's collider is
+  // drawn from its part-meshes file.
+  EXPECT_EQ(count(html, "<img "), 1u + 1u + 3u + 5u);
+  EXPECT_EQ(count(html, "src=\"data:image/svg+xml;base64,"), 10u);
   EXPECT_EQ(count(html, "<svg class=\"shape\""), 5u);
+  EXPECT_EQ(count(html, "<svg class=\"colour-bar\""), 3u);
+  EXPECT_EQ(count(html, "class=\"collider\""), static_cast<std::size_t>(test::kColliderTriangles));
+  EXPECT_NE(html.find("job #1, level 0 of 3 (preview)"), std::string::npos);
+  EXPECT_NE(html.find("job #1, level 2 of 3 (final)"), std::string::npos);
+  EXPECT_NE(html.find("alt=\"max displacement against thickness\""), std::string::npos);
+  EXPECT_NE(html.find("alt=\"job #1, level 1: residual in each Newton solve\""),
+            std::string::npos);
+  EXPECT_NE(html.find("Hierarchy cache: not used"), std::string::npos);
   EXPECT_EQ(count(html, "http:"), 0u);
   EXPECT_EQ(count(html, "https:"), 0u);
   EXPECT_EQ(count(html, "<h2 id=\"job-"), 4u);  // the finished jobs have sections

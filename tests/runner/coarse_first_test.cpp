@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <regex>
 
 #include "db/job_store.hpp"
@@ -162,6 +163,37 @@ TEST(CoarseFirst, TheRulePromotesItsSelectionWhichEndsAsARefineAllRunAndTheRestW
               std::string::npos)
         << line;
   }
+  // The page shows every point's preview picture, and beside the selected ones their final
+  // shape: 6 previews + 2 finals in the gallery.
+  const std::string html = test::read_file(coarse.dir / "report" / "report.html");
+  const auto gallery = html.find("Every point's preview");
+  ASSERT_NE(gallery, std::string::npos);
+  const std::string points = html.substr(gallery, html.find("<h2>", gallery) - gallery);
+  std::size_t point_blocks = 0, selected_blocks = 0, previews = 0, finals = 0;
+  for (const auto& [needle, counter] :
+       std::vector<std::pair<std::string, std::size_t*>>{{"<div class=\"point", &point_blocks},
+                                                         {"<div class=\"point selected", &selected_blocks},
+                                                         {"of 3 (preview): ", &previews},
+                                                         {"of 3 (final): ", &finals}})
+    for (auto at = points.find(needle); at != std::string::npos; at = points.find(needle, at + 1))
+      ++*counter;
+  EXPECT_EQ(point_blocks, 6u);
+  EXPECT_EQ(selected_blocks, 2u);
+  // Each picture's caption appears in its <title> and its <figcaption>.
+  EXPECT_EQ(previews, 2u * 6u);
+  EXPECT_EQ(finals, 2u * 2u);
+
+  // One hierarchy per attempt (a strip, no colliders): 6 preview attempts and 2 after the
+  // promotion. At most the two first claims (one per process) found the cache empty.
+  const auto json = nlohmann::json::parse(test::read_file(coarse.dir / "report" / "results.json"));
+  const nlohmann::json& cache = json["hierarchy_cache"];
+  EXPECT_EQ(cache["hits"].get<int>() + cache["builds"].get<int>(), 8) << cache;
+  EXPECT_GE(cache["builds"].get<int>(), 1);
+  EXPECT_LE(cache["builds"].get<int>(), 2);
+  EXPECT_EQ(cache["hits_without_build"].get<int>(), 0);
+  EXPECT_GT(cache["saved_seconds"].get<double>(), 0.0);
+  EXPECT_NE(html.find("Hierarchy cache: " + std::to_string(cache["hits"].get<int>()) + " hits and"),
+            std::string::npos);
 }
 
 TEST(CoarseFirst, TheDemoSweepRefinesTheThreeLowestHangingClothsAndPreviewsTheRest) {
