@@ -31,6 +31,7 @@ constexpr const char* kLevelConverged = "progressive.level_converged";  // befor
 constexpr const char* kSettlingFailed = "progressive.settling_failed";
 constexpr const char* kBestChange = "progressive.best_change";
 constexpr const char* kStalledSteps = "progressive.stalled_steps";
+constexpr const char* kUnconvergedStep = "progressive.unconverged_step";
 
 /// Settling steps at the largest time step in a row that do not bring the change 1 % below the
 /// best one so far before a settling is given up: a state cycling between two answers (friction
@@ -276,6 +277,7 @@ void ProgressiveSimulation::enter_level(int level) {
   // (in a fixed-step scene: stepped once).
   settled_ = level == 0;
   settling_failed_ = false;
+  unconverged_step_ = false;
   settle_steps_ = 0;
   best_change_ = std::numeric_limits<double>::infinity();
   stalled_steps_ = 0;
@@ -365,6 +367,9 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
     out.judged = finest_level();
     out.converged = out.frame.newton.converged;
   }
+  // In a fixed-step scene each judged step is its frame's answer; in an equilibrium scene the
+  // frame's settling judges it (settling_failed_).
+  if (!frames_are_equilibria() && out.judged && !out.converged) unconverged_step_ = true;
   return out;
 }
 
@@ -428,6 +433,7 @@ std::map<std::string, double> ProgressiveSimulation::schedule_state() const {
                                       {kSettleGrowth, settle_growth_},
                                       {kSettled, settled_ ? 1.0 : 0.0},
                                       {kSettlingFailed, settling_failed_ ? 1.0 : 0.0},
+                                      {kUnconvergedStep, unconverged_step_ ? 1.0 : 0.0},
                                       {kStalledSteps, stalled_steps_}};
   // Stored values must be finite; none is stored before the first step at the largest Δt.
   if (std::isfinite(best_change_)) state[kBestChange] = best_change_;
@@ -481,6 +487,7 @@ void ProgressiveSimulation::restore(int level, int frame, const Eigen::VectorXd&
     settled_ = *settled != 0.0;
     // Stores written before settling_failed kept whether the level's one settling converged.
     settling_failed_ = failed ? *failed != 0.0 : settled_ && *converged == 0.0;
+    unconverged_step_ = stored(kUnconvergedStep).value_or(0.0) != 0.0;
     resumed_iterations_ = iterations_in_frame;
     return;
   }

@@ -114,9 +114,12 @@ class ProgressiveSimulation {
   /// The current level is the finest: its steps must converge, while coarser levels are
   /// previews whose steps may stop at preview_iterations.
   [[nodiscard]] bool finest_level() const { return level_ + 1 == level_count_; }
-  /// Whether the current level is done and every settling of its frames met its tolerance
-  /// (rather than stopping at max_settle_steps or stalling).
-  [[nodiscard]] bool level_converged() const { return level_done() && !settling_failed_; }
+  /// Whether the current level is done, every settling of its frames met its tolerance (rather
+  /// than stopping at max_settle_steps or stalling) and, in a fixed-step scene, every judged
+  /// step converged.
+  [[nodiscard]] bool level_converged() const {
+    return level_done() && !settling_failed_ && !unconverged_step_;
+  }
 
   /// Tolerance on ‖d‖∞/Δt (and on the settling change) at the current level.
   [[nodiscard]] double tolerance() const;
@@ -235,6 +238,8 @@ class ProgressiveSimulation {
   bool settled_ = false;
   /// A settling of this level stopped (at max_settle_steps, or stalled) without passing its test.
   bool settling_failed_ = false;
+  /// A judged step of a fixed-step scene at this level ended without converging.
+  bool unconverged_step_ = false;
   int settle_steps_ = 0;
   /// The smallest settling change at the largest time step so far, and the steps since it last
   /// improved by 1 % (a stalled settling is given up).

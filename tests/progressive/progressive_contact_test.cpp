@@ -242,6 +242,30 @@ TEST(ProgressiveContact, AFixedStepScenesFirstFinestStepHasTheBudgetOfSeveralFra
   EXPECT_EQ(intersections(sim.level_system(), sim.positions()), 0u);
 }
 
+TEST(ProgressiveContact, AFixedStepFinestStepThatDoesNotConvergeLeavesTheLevelNotConverged) {
+  // Five frames of 5 iterations are too few for the CI twist's first finest step (about 47).
+  Scene scene = scene_from(kTwist, "twist");
+  scene.solver.max_iterations = 5;
+  ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
+  settings.schedule.levels = 2;
+  ProgressiveSimulation sim(scene, settings);
+  bool finest_step_converged = true;
+  for (;;) {
+    while (!sim.level_done()) {
+      const ProgressiveStep step = sim.step();
+      if (sim.finest_level()) finest_step_converged = step.converged;
+    }
+    if (sim.finished()) break;
+    sim.refine();
+  }
+  EXPECT_FALSE(finest_step_converged);
+  EXPECT_FALSE(sim.level_converged());
+  // A level restored from its schedule state keeps the verdict.
+  ProgressiveSimulation resumed(scene, settings);
+  resumed.restore(1, sim.frame(), sim.positions(), sim.positions(), 0, sim.schedule_state());
+  EXPECT_FALSE(resumed.level_converged());
+}
+
 TEST(ProgressiveContact, CrushIsIntersectionFreeAtEveryLevelAndConverges) {
   const ProgressiveRun run = run_checked(scene_from(kCrush, "crush"), 2);
   expect_safe("crush", run, 2);
