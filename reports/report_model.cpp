@@ -66,9 +66,11 @@ std::vector<LevelReport> levels_of(const db::JobResult& result) {
     if (record != result.levels.end()) {
       levels.push_back(level_from_record(*record));
     } else {
+      const bool stopped_at_preview = result.job.state == db::JobState::previewed &&
+                                      result.job.preview_levels && l >= *result.job.preview_levels;
       levels.push_back({});
       levels.back().level = l;
-      levels.back().status = "missing";
+      levels.back().status = stopped_at_preview ? "not refined" : "missing";
     }
   }
   return levels;

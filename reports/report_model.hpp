@@ -38,8 +38,8 @@ struct NewtonSolve {
 /// One hierarchy level of a job.
 struct LevelReport {
   int level = 0;  ///< 0 = coarsest
-  /// The store's level status ("running", "done", "failed"), or "missing" when the store has
-  /// no record of the level.
+  /// The store's level status ("running", "done", "failed"); without a record of the level,
+  /// "not refined" for a level past a previewed job's preview, else "missing".
   std::string status;
   std::int64_t iterations = 0;
   std::vector<double> residuals;  ///< per Newton iteration, as recorded in the store

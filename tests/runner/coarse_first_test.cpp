@@ -218,8 +218,19 @@ TEST(CoarseFirst, TheDemoSweepRefinesTheThreeLowestHangingClothsAndPreviewsTheRe
   }
   const test::ProcessResult report =
       demo.psq({"report", "demo", "--out", (demo.dir / "report").string()});
-  EXPECT_EQ(report.exit_code, 0) << report.errors;
+  ASSERT_EQ(report.exit_code, 0) << report.errors;
   EXPECT_TRUE(fs::exists(demo.dir / "report" / "report.html"));
+  // The six finest levels never run are the selection's doing, not records gone missing.
+  const std::string summary = test::read_file(demo.dir / "report" / "summary.md");
+  const auto section = summary.find("## Levels");
+  ASSERT_NE(section, std::string::npos) << summary;
+  const std::string levels = summary.substr(section);
+  std::size_t not_refined = 0;
+  for (auto at = levels.find("| not refined |"); at != std::string::npos;
+       at = levels.find("| not refined |", at + 1))
+    ++not_refined;
+  EXPECT_EQ(not_refined, 6u) << levels;
+  EXPECT_EQ(levels.find("| missing |"), std::string::npos) << levels;
 }
 
 TEST(CoarseFirst, PromoteByHandRefinesTheChosenPreviewsFromTheirCheckpoints) {
