@@ -43,8 +43,7 @@ constexpr double kSettleProgress = 0.99;
 /// The Newton budget of a fixed-step scene's first step at the finest level, in the scene's
 /// max_iterations. That step starts from the initializer, not from the previous frame, and
 /// corrects the whole difference between the prolonged coarse answer and the fine one, which an
-/// equilibrium scene's settling spreads over several steps (twist_wrap at 2230 fine vertices:
-/// 257 iterations, where a frame of its direct solve takes up to 121).
+/// equilibrium scene's settling spreads over several steps (docs/benchmarks.md, twist_wrap).
 constexpr int kEntryStepBudgets = 5;
 
 /// The shells and colliders of `system` as named parts, for intersection listings.
@@ -316,9 +315,10 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   const int iterations_done = std::exchange(resumed_iterations_, 0);
   if (iterations_done == 0) previous_ = x_;
   if (!out.settling && iterations_done == 0) frame_start_ = previous_;
+  // The refine frame's one step of Δt at a level entered by refinement (a fixed-step scene).
+  const bool entry_step = out.settling && !frames_are_equilibria();
   NewtonSettings settings = stepper_->settings();
-  if (out.settling && !frames_are_equilibria() && finest_level())
-    settings.max_iterations *= kEntryStepBudgets;
+  if (entry_step && finest_level()) settings.max_iterations *= kEntryStepBudgets;
   out.frame = stepper_->step(
       previous_, x_, frame, time_step, iterations_done, settings,
       [&](const NewtonIteration& it) {
@@ -328,9 +328,8 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   out.change = (x_ - previous_).lpNorm<Eigen::Infinity>() / finest_.scene().time.step;
   frame_ = frame;
   const bool converged_at_start = out.frame.newton.converged && out.frame.newton.iterations == 0;
-  if (out.settling && !frames_are_equilibria()) {
-    // The refine frame's step at a level entered by refinement: one step of Δt, as any frame of
-    // the path.
+  if (entry_step) {
+    // One step of Δt, as any frame of the path.
     settled_ = true;
     ++settle_steps_;
     out.judged = finest_level();

@@ -165,6 +165,19 @@ ProgressiveRun run_checked(const Scene& scene, int levels) {
   return run;
 }
 
+/// Runs `sim` to its end and returns the steps its finest level took.
+std::vector<ProgressiveStep> finest_steps_to_the_end(ProgressiveSimulation& sim) {
+  std::vector<ProgressiveStep> finest_steps;
+  for (;;) {
+    while (!sim.level_done()) {
+      ProgressiveStep step = sim.step();
+      if (sim.finest_level()) finest_steps.push_back(std::move(step));
+    }
+    if (sim.finished()) return finest_steps;
+    sim.refine();
+  }
+}
+
 void print_refinements(const std::string& name, const ProgressiveRun& run) {
   std::cout << name << ": " << run.states << " states checked, " << run.refinements.size()
             << " refinements, finest level " << (run.converged ? "converged" : "NOT converged")
@@ -224,15 +237,7 @@ TEST(ProgressiveContact, AFixedStepScenesFirstFinestStepHasTheBudgetOfSeveralFra
   ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
   settings.schedule.levels = 2;
   ProgressiveSimulation sim(scene, settings);
-  std::vector<ProgressiveStep> finest_steps;
-  for (;;) {
-    while (!sim.level_done()) {
-      ProgressiveStep step = sim.step();
-      if (sim.finest_level()) finest_steps.push_back(std::move(step));
-    }
-    if (sim.finished()) break;
-    sim.refine();
-  }
+  const std::vector<ProgressiveStep> finest_steps = finest_steps_to_the_end(sim);
   ASSERT_EQ(finest_steps.size(), 1u);  // the refine frame is the last frame
   const ProgressiveStep& step = finest_steps.front();
   EXPECT_TRUE(step.settling);
@@ -249,16 +254,9 @@ TEST(ProgressiveContact, AFixedStepFinestStepThatDoesNotConvergeLeavesTheLevelNo
   ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
   settings.schedule.levels = 2;
   ProgressiveSimulation sim(scene, settings);
-  bool finest_step_converged = true;
-  for (;;) {
-    while (!sim.level_done()) {
-      const ProgressiveStep step = sim.step();
-      if (sim.finest_level()) finest_step_converged = step.converged;
-    }
-    if (sim.finished()) break;
-    sim.refine();
-  }
-  EXPECT_FALSE(finest_step_converged);
+  const std::vector<ProgressiveStep> finest_steps = finest_steps_to_the_end(sim);
+  ASSERT_FALSE(finest_steps.empty());
+  EXPECT_FALSE(finest_steps.back().converged);
   EXPECT_FALSE(sim.level_converged());
   // A level restored from its schedule state keeps the verdict.
   ProgressiveSimulation resumed(scene, settings);
