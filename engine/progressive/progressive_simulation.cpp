@@ -219,6 +219,7 @@ NewtonSettings ProgressiveSimulation::level_newton_settings(int level) const {
   newton.max_iterations =
       finest ? scene.solver.max_iterations : settings_.schedule.preview_iterations;
   newton.tolerance = finest ? finest_tolerance_ : preview_tolerance_;
+  newton.project_on_demand = scene.solver.project_on_demand;
   // Below the finest level a step capped at preview_iterations is not meant to converge, and the
   // settling's change test decides when the level is done.
   newton.judge_final_iterate = finest;

@@ -67,13 +67,14 @@ void ProxyElastics::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) c
                                               : to_finest_.apply_linear_transpose(fine_g);
 }
 
-void ProxyElastics::hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches) const {
+void ProxyElastics::hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches,
+                            bool project_psd) const {
   const std::size_t shells = level_.membranes().size();
   batches.resize(2 * shells);
   for (std::size_t s = 0; s < shells; ++s) {
-    level_.membranes()[s].hessian(x, batches[2 * s]);
+    level_.membranes()[s].hessian(x, batches[2 * s], project_psd);
     ElementMatrices& bending = batches[2 * s + 1];
-    level_.bendings()[s].hessian(x, bending);
+    level_.bendings()[s].hessian(x, bending, project_psd);
     Eigen::Map<Eigen::VectorXd>(bending.values.data(),
                                 static_cast<Eigen::Index>(bending.values.size())) *= bending_scale_[s];
   }

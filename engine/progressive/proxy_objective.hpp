@@ -42,7 +42,8 @@ class ProxyElastics : public ElasticModel {
   [[nodiscard]] double elastic_energy(const Eigen::VectorXd& x) const override;
   [[nodiscard]] double energy(const Eigen::VectorXd& x) const override;
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const override;
-  void hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches) const override;
+  void hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches,
+               bool project_psd) const override;
 
  private:
   /// What the proxy knows at one coarse x, independent of xᵗ and Δt. Filled lazily and

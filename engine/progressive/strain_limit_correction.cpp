@@ -122,7 +122,7 @@ void StretchExcess::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
   H.batches.resize(contact_ ? 2 : 1);
   H.batches[0].reset(3, std::move(stencils));
   for (std::size_t e = 0; e < blocks.size(); ++e) H.batches[0].block(e) = blocks[e];
-  if (contact_) contact_->hessian(x, H.fixed_vertices, H.diagonal, H.batches[1]);
+  if (contact_) contact_->hessian(x, H.fixed_vertices, H.project, H.diagonal, H.batches[1]);
 }
 
 double StretchExcess::max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {

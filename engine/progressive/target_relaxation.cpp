@@ -60,7 +60,7 @@ void TargetPull::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
 void TargetPull::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
   H.diagonal = Eigen::VectorXd::Ones(size());
   H.batches.resize(1);
-  contact_.hessian(x, H.fixed_vertices, H.diagonal, H.batches[0]);
+  contact_.hessian(x, H.fixed_vertices, H.project, H.diagonal, H.batches[0]);
 }
 
 double TargetPull::max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) {

@@ -119,6 +119,9 @@ struct SolverSettings {
   /// non-convergence.
   int max_iterations = 200;
   FrameSolution frame_solution = FrameSolution::equilibrium;
+  /// [solver] hessian: "project_on_demand" (true) or "projected" (NewtonSettings::
+  /// project_on_demand).
+  bool project_on_demand = false;
 };
 
 /// The [hierarchy] table: progressive simulation over a coarse-to-fine hierarchy (paper §3,

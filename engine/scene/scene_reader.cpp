@@ -685,7 +685,7 @@ SolverSettings read_solver(const Section& root) {
   SolverSettings solver;
   const auto section = root.optional_table("solver");
   if (!section) return solver;
-  section->allow_only({"tolerance", "max_iterations", "frame_solution"});
+  section->allow_only({"tolerance", "max_iterations", "frame_solution", "hessian"});
   solver.tolerance = read_optional_positive(*section, "tolerance");
   solver.max_iterations = read_count(*section, "max_iterations", solver.max_iterations);
   solver.frame_solution =
@@ -693,6 +693,9 @@ SolverSettings read_solver(const Section& root) {
               "fixed_step"
           ? FrameSolution::fixed_step
           : FrameSolution::equilibrium;
+  solver.project_on_demand =
+      read_choice(*section, "hessian", {"projected", "project_on_demand"}, "projected") ==
+      "project_on_demand";
   return solver;
 }
 

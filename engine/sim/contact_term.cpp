@@ -151,8 +151,9 @@ void ContactTerm::load_state(const std::map<std::string, double>& state) {
 }
 
 void ContactTerm::hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-                          Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
-  potential_.hessian(x, blocks, true, fixed_vertices);
+                          bool project_psd, Eigen::VectorXd& /*diagonal*/,
+                          ElementMatrices& blocks) {
+  potential_.hessian(x, blocks, project_psd, fixed_vertices);
 }
 
 }  // namespace psq

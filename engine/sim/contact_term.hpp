@@ -68,7 +68,7 @@ class ContactTerm : public PotentialTerm {
     potential_.add_gradient(x, g);
   }
   void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
+               bool project_psd, Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) override {
     return potential_.max_feasible_step(x, dx);
   }

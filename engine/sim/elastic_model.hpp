@@ -21,8 +21,10 @@ class ElasticModel {
   [[nodiscard]] virtual double energy(const Eigen::VectorXd& x) const = 0;
   /// g += ∇(Ψ − f·x)(x).
   virtual void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const = 0;
-  /// PSD element blocks approximating ∇²Ψ(x), written to `batches` (resized by the model).
-  virtual void hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches) const = 0;
+  /// PSD element blocks approximating ∇²Ψ(x), or with `project_psd` false the elements'
+  /// unprojected Hessians, written to `batches` (resized by the model).
+  virtual void hessian(const Eigen::VectorXd& x, std::vector<ElementMatrices>& batches,
+                       bool project_psd) const = 0;
 };
 
 }  // namespace psq

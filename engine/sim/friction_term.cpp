@@ -96,8 +96,10 @@ void FrictionTerm::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
   potential_.add_gradient(x, g);
 }
 
+// Its blocks are PSD as they stand (friction_mollifier_hessian), so there is nothing to project.
 void FrictionTerm::hessian(const Eigen::VectorXd& x, const std::vector<bool>& /*fixed_vertices*/,
-                           Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
+                           bool /*project_psd*/, Eigen::VectorXd& /*diagonal*/,
+                           ElementMatrices& blocks) {
   const ScopedTimer timer(seconds_);
   potential_.hessian(x, blocks);
 }

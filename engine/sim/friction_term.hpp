@@ -62,7 +62,7 @@ class FrictionTerm : public PotentialTerm {
   double value(const Eigen::VectorXd& x) override;
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
   void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
+               bool project_psd, Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
 
  private:
   BodyFrictionTable coefficients_;

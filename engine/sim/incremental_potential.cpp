@@ -52,20 +52,21 @@ void IncrementalPotential::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
   H.diagonal = inertia_weight_ * system_.dof_masses();
   std::size_t elastic_batches = 0;
   if (elastics_) {
-    elastics_->hessian(x, H.batches);
+    elastics_->hessian(x, H.batches, H.project);
     elastic_batches = H.batches.size();
   } else {
     const std::size_t shells = system_.membranes().size();
     elastic_batches = 2 * shells;
     H.batches.resize(elastic_batches);
     for (std::size_t s = 0; s < shells; ++s) {
-      system_.membranes()[s].hessian(x, H.batches[2 * s]);
-      system_.bendings()[s].hessian(x, H.batches[2 * s + 1]);
+      system_.membranes()[s].hessian(x, H.batches[2 * s], H.project);
+      system_.bendings()[s].hessian(x, H.batches[2 * s + 1], H.project);
     }
   }
   H.batches.resize(elastic_batches + terms_.size());
   for (std::size_t t = 0; t < terms_.size(); ++t)
-    terms_[t]->hessian(x, H.fixed_vertices, H.diagonal, H.batches[elastic_batches + t]);
+    terms_[t]->hessian(x, H.fixed_vertices, H.project, H.diagonal,
+                       H.batches[elastic_batches + t]);
 }
 
 double IncrementalPotential::max_feasible_step(const Eigen::VectorXd& x,

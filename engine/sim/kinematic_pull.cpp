@@ -27,8 +27,8 @@ void KinematicPull::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
 }
 
 void KinematicPull::hessian(const Eigen::VectorXd& /*x*/,
-                            const std::vector<bool>& /*fixed_vertices*/, Eigen::VectorXd& diagonal,
-                            ElementMatrices& blocks) {
+                            const std::vector<bool>& /*fixed_vertices*/, bool /*project_psd*/,
+                            Eigen::VectorXd& diagonal, ElementMatrices& blocks) {
   blocks.reset(0, {});
   for (std::size_t i = 0; i < vertices_.size(); ++i)
     diagonal.segment<3>(3 * vertices_[i]) += stiffness_ * weights_[i];

@@ -33,7 +33,7 @@ class KinematicPull : public PotentialTerm {
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
   /// Diagonal only: k wᵢ_c on the DOFs of each pulled vertex.
   void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
+               bool project_psd, Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
 
  private:
   std::vector<int> vertices_;

@@ -25,10 +25,11 @@ class PotentialTerm {
   /// g += ∇(term)(x).
   virtual void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) = 0;
   /// A PSD approximation of the term's Hessian over the vertices the solve moves (those not in
-  /// `fixed_vertices`, HessianBlocks): entries added to `diagonal` (size 3n) and/or element
-  /// blocks written to `blocks` (which the term resets, possibly to no element).
+  /// `fixed_vertices`, HessianBlocks), or the Hessian itself where the term projects blocks
+  /// and `project_psd` is false (HessianBlocks::project): entries added to `diagonal` (size 3n)
+  /// and/or element blocks written to `blocks` (which the term resets, possibly to no element).
   virtual void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-                       Eigen::VectorXd& diagonal, ElementMatrices& blocks) = 0;
+                       bool project_psd, Eigen::VectorXd& diagonal, ElementMatrices& blocks) = 0;
   /// Largest α ∈ (0, 1] keeping x + α·dx feasible for this term; 1 when unconstrained.
   virtual double max_feasible_step(const Eigen::VectorXd& /*x*/, const Eigen::VectorXd& /*dx*/) {
     return 1.0;

@@ -27,6 +27,7 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
       previous_(x_) {
   settings_.step_scale = scene.time.step;
   settings_.max_iterations = scene.solver.max_iterations;
+  settings_.project_on_demand = scene.solver.project_on_demand;
   settings_.tolerance =
       scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(system_.rest_mesh().vertices));
 }

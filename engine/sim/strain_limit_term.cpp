@@ -103,9 +103,12 @@ void StrainLimitTerm::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g)
   for (const StrainLimitEnergy& energy : energies_) energy.add_gradient(x, g);
 }
 
+// Its stress derivative has no negative eigenvalue but rounding's (strain_limit.hpp), so its
+// blocks are projected always: that only clamps the rounding.
 void StrainLimitTerm::hessian(const Eigen::VectorXd& x,
                               const std::vector<bool>& /*fixed_vertices*/,
-                              Eigen::VectorXd& /*diagonal*/, ElementMatrices& blocks) {
+                              bool /*project_psd*/, Eigen::VectorXd& /*diagonal*/,
+                              ElementMatrices& blocks) {
   blocks.reset(3, {});
   for (const StrainLimitEnergy& energy : energies_) {
     energy.hessian(x, shell_blocks_);

@@ -43,7 +43,7 @@ class StrainLimitTerm : public PotentialTerm {
   double value(const Eigen::VectorXd& x) override;
   void add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override;
   void hessian(const Eigen::VectorXd& x, const std::vector<bool>& fixed_vertices,
-               Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
+               bool project_psd, Eigen::VectorXd& diagonal, ElementMatrices& blocks) override;
   /// 1 when no limited shell's triangle reaches its limit along x + α dx, α ∈ [0, 1]; else
   /// 0.9 × the smallest StrainLimitEnergy::max_feasible_step, so that each triangle keeps at
   /// least a tenth of its slack.

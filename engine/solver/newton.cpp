@@ -159,10 +159,17 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
       free_gradient = dofs.restrict(gradient);
     }
     record.gradient_norm = free_gradient.norm();
-    const Eigen::VectorXd free_direction =
-        search_direction(objective, x, dofs, free_gradient, record);
+    Eigen::VectorXd free_direction = search_direction(objective, x, dofs, free_gradient,
+                                                      settings.project_on_demand, record);
+    record.step_norm = free_direction.lpNorm<Eigen::Infinity>() / settings.step_scale;
+    // The tolerance is a bound on the projected Newton step (IPC's measure): ∇²E can be stiffer
+    // than its projection where bent hinges add curvature, and its shorter step would pass the
+    // test with more force left unbalanced. So a short unprojected step is judged projected.
+    if (!record.projected && record.step_norm < settings.tolerance) {
+      free_direction = search_direction(objective, x, dofs, free_gradient, false, record);
+      record.step_norm = free_direction.lpNorm<Eigen::Infinity>() / settings.step_scale;
+    }
     const Eigen::VectorXd direction = dofs.extend(free_direction);
-    record.step_norm = direction.lpNorm<Eigen::Infinity>() / settings.step_scale;
 
     // A gradient fallback step says nothing about the distance to the minimum.
     result.converged =
@@ -194,24 +201,37 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
   return result;
 }
 
-Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen::VectorXd& x,
-                                               const DofMap& dofs,
-                                               const Eigen::VectorXd& free_gradient,
-                                               NewtonIteration& record) {
-  // A stationary point (or nothing free to move): d = 0 exactly, no system to solve.
-  if (free_gradient.isZero(0.0)) return Eigen::VectorXd::Zero(free_gradient.size());
+void NewtonSolver::assemble_hessian(Objective& objective, const Eigen::VectorXd& x,
+                                    const DofMap& dofs, bool project, NewtonIteration& record) {
+  bool pattern_changed = false;
   {
     ScopedTimer timer(record.times.assembly);
+    hessian_.project = project;
     objective.hessian(x, hessian_);
-    record.pattern_changed = assembler_.assemble(hessian_, dofs);
+    pattern_changed = assembler_.assemble(hessian_, dofs);
   }
-  if (record.pattern_changed || !cholmod_.analyzed()) {
+  record.pattern_changed = record.pattern_changed || pattern_changed;
+  if (pattern_changed || !cholmod_.analyzed()) {
     ScopedTimer timer(record.times.factorization);
     cholmod_.analyze(assembler_.matrix());
   }
+}
 
+Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen::VectorXd& x,
+                                               const DofMap& dofs,
+                                               const Eigen::VectorXd& free_gradient,
+                                               bool try_unprojected, NewtonIteration& record) {
+  // A stationary point (or nothing free to move): d = 0 exactly, no system to solve.
+  if (free_gradient.isZero(0.0)) return Eigen::VectorXd::Zero(free_gradient.size());
   Eigen::VectorXd direction;
   record.direction = DirectionKind::newton;
+  if (try_unprojected) {
+    assemble_hessian(objective, x, dofs, false, record);
+    record.projected = false;
+    if (try_newton(0.0, free_gradient, direction, record)) return direction;
+  }
+  record.projected = true;
+  assemble_hessian(objective, x, dofs, true, record);
   if (try_newton(0.0, free_gradient, direction, record)) return direction;
 
   record.direction = DirectionKind::shifted_newton;

@@ -37,6 +37,15 @@ struct NewtonSettings {
   /// barrier's κ) gets control back at once instead of after its whole iteration budget.
   int max_cut_steps = 0;
   double cut_step = 0.1;  ///< the feasible step below which a step counts as cut
+  /// Project-on-demand Newton (Longva et al. 2023, "Pitfalls of Projection"): each direction
+  /// is first solved with ∇²E itself (HessianBlocks::project = false), and only when that is
+  /// not positive definite with the element-wise PSD projection. The projection overstates the
+  /// curvature of compressed membranes, bent hinges and contact pairs, so projected Newton
+  /// crawls through flat valleys in short steps (docs/benchmarks.md). Convergence is still
+  /// judged on the projected step, so the tolerance means what it means without. Off by
+  /// default: the equilibria it settles in can differ where a scene has several (a hanging
+  /// drape), and it leaves stiff modes less over-solved (docs/scene-format.md).
+  bool project_on_demand = false;
 };
 
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected
@@ -65,7 +74,11 @@ class NewtonSolver {
   /// DOFs and records how it was obtained.
   Eigen::VectorXd search_direction(Objective& objective, const Eigen::VectorXd& x,
                                    const DofMap& dofs, const Eigen::VectorXd& free_gradient,
-                                   NewtonIteration& record);
+                                   bool try_unprojected, NewtonIteration& record);
+  /// Asks the objective for its Hessian (projected or not), assembles it over the free DOFs
+  /// and analyzes its pattern when that changed.
+  void assemble_hessian(Objective& objective, const Eigen::VectorXd& x, const DofMap& dofs,
+                        bool project, NewtonIteration& record);
   /// Factorizes K + shift·I and solves for d; false when that matrix is not positive definite
   /// or d is not a descent direction (gᵀd ≥ 0).
   bool try_newton(double shift, const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,

@@ -18,6 +18,11 @@ struct HessianBlocks {
   /// Its rows never reach the system, so a term may project only the block of the vertices
   /// that move (project_moving_block_to_psd).
   std::vector<bool> fixed_vertices;
+  /// Set by the solver before it asks: false asks for ∇²E itself, its element blocks not
+  /// projected (NewtonSettings::project_on_demand), so near a minimum Newton sees the curvature
+  /// the projection would overstate. An objective without such blocks may answer with its PSD
+  /// approximation.
+  bool project = true;
 };
 
 class Objective {
@@ -28,7 +33,8 @@ class Objective {
   virtual double value(const Eigen::VectorXd& x) = 0;
   /// Overwrites g (resized to size()) with ∇E(x).
   virtual void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) = 0;
-  /// Overwrites H with a positive semi-definite approximation of ∇²E(x).
+  /// Overwrites H with a positive semi-definite approximation of ∇²E(x), or with ∇²E(x) where
+  /// it can when H.project is false.
   virtual void hessian(const Eigen::VectorXd& x, HessianBlocks& H) = 0;
   /// Largest α in (0, 1] such that x + α·dx stays feasible (intersection-free, within
   /// strain limits). Unconstrained objectives return 1.

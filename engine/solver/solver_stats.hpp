@@ -27,7 +27,7 @@ struct PhaseTimes {
 
 /// How the search direction of an iteration was obtained.
 enum class DirectionKind {
-  newton,          ///< d = −K⁻¹g with the projected Hessian K
+  newton,          ///< d = −K⁻¹g with K = ∇²E or its projection (NewtonIteration::projected)
   shifted_newton,  ///< d = −(K + σI)⁻¹g: K was not positive definite or d was not descent
   gradient,        ///< d = −g: every shift failed too
 };
@@ -47,6 +47,9 @@ struct NewtonIteration {
   DirectionKind direction = DirectionKind::newton;
   double shift = 0.0;            ///< σ when direction == shifted_newton
   bool pattern_changed = false;  ///< the sparsity pattern changed, so it was re-analyzed
+  /// d came from the element-wise PSD-projected Hessian (false: from ∇²E itself, which was
+  /// positive definite; NewtonSettings::project_on_demand).
+  bool projected = true;
   PhaseTimes times;
 };
 

@@ -27,6 +27,7 @@ inline DirectRun settled_direct_run(const ShellSystem& system, double tolerance,
   newton.step_scale = scene.time.step;
   newton.tolerance = tolerance;
   newton.max_iterations = scene.solver.max_iterations;
+  newton.project_on_demand = scene.solver.project_on_demand;
   LevelStepper stepper(system, std::make_unique<LevelObjective>(system, scene.time.step), newton);
   DirectRun run;
   run.positions = flat(system.rest_mesh().vertices);

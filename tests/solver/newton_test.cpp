@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -708,6 +709,76 @@ TEST(Newton, RejectsBadSettings) {
   settings = NewtonSettings{};
   settings.cut_step = 0.0;
   EXPECT_THROW(solver.minimize(probe, x, DofMap(1, {}), settings), InputError);
+}
+
+/// One free vertex with E = Σ_c [a (x_c − 1)² + b (x_c − 1)⁴ + c (x_c − 1)²] in two element
+/// batches: the convex part a (·)² + b (·)⁴, and c (·)² with c < 0, whose block (2c I) the
+/// projection clamps to zero, as it clamps a compressed membrane's negative curvature.
+class ConcavePartObjective : public Objective {
+ public:
+  ConcavePartObjective(double a, double b, double c) : a_(a), b_(b), c_(c) {}
+  [[nodiscard]] Eigen::Index size() const override { return 3; }
+  double value(const Eigen::VectorXd& x) override {
+    const Eigen::ArrayXd u = x.array() - 1.0;
+    return ((a_ + c_) * u.square() + b_ * u.square().square()).sum();
+  }
+  void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+    const Eigen::ArrayXd u = x.array() - 1.0;
+    g = (2.0 * (a_ + c_) * u + 4.0 * b_ * u.cube()).matrix();
+  }
+  void hessian(const Eigen::VectorXd& x, HessianBlocks& h) override {
+    const Eigen::ArrayXd u = x.array() - 1.0;
+    h.diagonal.resize(0);
+    h.batches.resize(2);
+    h.batches[0].reset(1, {0});
+    h.batches[0].block(0) = (2.0 * a_ + 12.0 * b_ * u.square()).matrix().asDiagonal();
+    h.batches[1].reset(1, {0});
+    h.batches[1].block(0) = 2.0 * c_ * Eigen::Matrix3d::Identity();
+    if (h.project) project_to_psd(h.batches[1].block(0));
+  }
+
+ private:
+  double a_, b_, c_;
+};
+
+TEST(Newton, ProjectOnDemandTakesTheExactStepWhereTheProjectionOverstatesCurvature) {
+  // E = 0.1 (x − 1)² per coordinate: ∇²E = 0.2 I, its projection 2 I (the −1.8 I clamped), so
+  // projected Newton's full steps go only a tenth of the way.
+  NewtonSettings settings;
+  settings.tolerance = 1e-10;
+  settings.project_on_demand = true;
+  NewtonSolver solver;
+  ConcavePartObjective on_demand(1.0, 0.0, -0.9);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(3, 2.0);
+  const NewtonResult exact = solver.minimize(on_demand, x, DofMap(1, {}), settings);
+  ASSERT_TRUE(exact.converged);
+  EXPECT_EQ(exact.iterations, 1);
+  EXPECT_FALSE(exact.history.front().projected);
+  EXPECT_NEAR((x.array() - 1.0).abs().maxCoeff(), 0.0, 1e-12);
+
+  settings.project_on_demand = false;
+  x.setConstant(2.0);
+  const NewtonResult projected = solver.minimize(on_demand, x, DofMap(1, {}), settings);
+  ASSERT_TRUE(projected.converged);
+  EXPECT_TRUE(projected.history.front().projected);
+  EXPECT_GT(projected.iterations, 3);
+}
+
+TEST(Newton, ProjectOnDemandProjectsWhereTheHessianIsIndefinite) {
+  // E = −0.75 u² + u⁴ (u = x − 1): ∇²E = −1.5 + 12 u² is negative near u = 0.1, where the
+  // solve starts, and positive at the minimum u = √0.375.
+  NewtonSettings settings;
+  settings.tolerance = 1e-10;
+  settings.project_on_demand = true;
+  NewtonSolver solver;
+  ConcavePartObjective objective(0.0, 1.0, -0.75);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(3, 1.1);
+  const NewtonResult result = solver.minimize(objective, x, DofMap(1, {}), settings);
+  ASSERT_TRUE(result.converged);
+  EXPECT_TRUE(result.history.front().projected);
+  EXPECT_TRUE(std::any_of(result.history.begin(), result.history.end(),
+                          [](const NewtonIteration& it) { return !it.projected; }));
+  EXPECT_NEAR((x.array() - 1.0 - std::sqrt(0.375)).abs().maxCoeff(), 0.0, 1e-8);
 }
 
 }  // namespace
