@@ -241,6 +241,12 @@ void FrameSolver::solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous
 }
 
 void FrameSolver::finish_frame(const Eigen::VectorXd& x, FrameRecord& record) {
+  record.load_scale = system_.load_scale();
+  if (!system_.probes().empty()) {
+    Eigen::VectorXd static_gradient;
+    potential_.static_gradient(x, static_gradient);
+    record.probes = read_probes(system_, x, static_gradient);
+  }
   if (!contact_) return;
   Eigen::VectorXd target = x;
   system_.apply_pins(target, record.time);
