@@ -374,8 +374,58 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
                 nlohmann::json(level.static_residuals).dump(),
                 named_numbers_json(level.refinement), named_numbers_json(level.outputs))
       .run();
+  write_frames(lease.job_id, level);
   if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();
+}
+
+void JobStore::write_frames(const std::string& job_id, const LevelRecord& level) {
+  auto frame = connection_.prepare(
+      "REPLACE INTO frames (job_id, level, frame, load_scale) VALUES (?1, ?2, ?3, ?4)");
+  auto probe = connection_.prepare(
+      "REPLACE INTO probe_readings (job_id, level, frame, probe, kind, x, y, z) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+  for (const FrameReadings& readings : level.frames) {
+    frame.reset().bind_all(job_id, level.level, readings.frame, readings.load_scale).run();
+    for (const ProbeValue& value : readings.probes)
+      probe.reset()
+          .bind_all(job_id, level.level, readings.frame, value.probe, value.kind, value.value[0],
+                    value.value[1], value.value[2])
+          .run();
+  }
+}
+
+void JobStore::read_frames(const JobSelection& which, std::vector<JobResult>& results) {
+  std::map<std::pair<std::string, int>, LevelRecord*> level_of;
+  for (JobResult& result : results)
+    for (LevelRecord& level : result.levels) level_of[{result.job.id, level.level}] = &level;
+  const auto level_record = [&](const std::string& job, int level) -> LevelRecord* {
+    const auto found = level_of.find({job, level});
+    return found == level_of.end() ? nullptr : found->second;
+  };
+  auto frames = connection_.prepare(fmt::format(
+      "SELECT job_id, level, frame, load_scale FROM frames WHERE job_id IN (SELECT jobs.id FROM "
+      "jobs WHERE {}) ORDER BY job_id, level, frame",
+      selection_condition(which)));
+  frames.bind_all(selection_value(which));
+  while (frames.step())
+    if (LevelRecord* level = level_record(frames.text(0), static_cast<int>(frames.integer(1))))
+      level->frames.push_back({static_cast<int>(frames.integer(2)), frames.real(3), {}});
+  auto probes = connection_.prepare(fmt::format(
+      "SELECT job_id, level, frame, probe, kind, x, y, z FROM probe_readings WHERE job_id IN "
+      "(SELECT jobs.id FROM jobs WHERE {}) ORDER BY job_id, level, frame, probe",
+      selection_condition(which)));
+  probes.bind_all(selection_value(which));
+  while (probes.step()) {
+    LevelRecord* level = level_record(probes.text(0), static_cast<int>(probes.integer(1)));
+    if (!level) continue;
+    const int number = static_cast<int>(probes.integer(2));
+    const auto frame = std::find_if(level->frames.begin(), level->frames.end(),
+                                    [&](const FrameReadings& f) { return f.frame == number; });
+    if (frame == level->frames.end()) continue;
+    frame->probes.push_back(
+        {probes.text(3), probes.text(4), {probes.real(5), probes.real(6), probes.real(7)}});
+  }
 }
 
 void JobStore::record_hierarchy_uses(const Lease& lease,
@@ -639,6 +689,7 @@ std::vector<JobResult> JobStore::results(const JobSelection& which) {
   while (uses.step())
     results[index_of.at(uses.text(0))].hierarchy_uses.push_back(
         {uses.text(1), uses.integer(2) != 0, uses.real(3), uses.integer(4)});
+  read_frames(which, results);
   return results;
 }
 
