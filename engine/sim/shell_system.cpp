@@ -164,8 +164,7 @@ void ShellSystem::add_probes(int shell_index, const TriMesh& mesh,
 }
 
 void ShellSystem::set_load_time(double time) {
-  load_scale_ = load_scale_at(scene_.load_scale, time);
-  external_force_ = weight_ + load_scale_ * loads_;
+  external_force_ = weight_ + load_scale_at(scene_.load_scale, time) * loads_;
 }
 
 ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,

@@ -109,8 +109,6 @@ class ShellSystem {
   /// Sets the time the external force is of: the loads scaled by the scene's load scale at
   /// `time` (scene.hpp, LoadScale); gravity stays as it is.
   void set_load_time(double time);
-  /// The load scale s of external_force().
-  [[nodiscard]] double load_scale() const { return load_scale_; }
   /// The scene's probes on this system's vertices, in scene order (none below the finest).
   [[nodiscard]] const std::vector<SystemProbe>& probes() const { return probes_; }
   /// The vertices with at least one fixed component (shell pins, then every collider vertex).
@@ -157,8 +155,7 @@ class ShellSystem {
   Eigen::VectorXd dof_masses_;
   Eigen::VectorXd weight_;      ///< gravity on the lumped masses, per DOF
   Eigen::VectorXd loads_;       ///< the loads at scale 1, per DOF
-  double load_scale_ = 0.0;     ///< of external_force_
-  Eigen::VectorXd external_force_;  ///< weight_ + load_scale_ · loads_
+  Eigen::VectorXd external_force_;  ///< weight_ + s · loads_ at the load time last set
   std::vector<PinnedVertex> pinned_;
   std::vector<SystemProbe> probes_;
   std::vector<std::vector<PinSources>> shared_pins_;  ///< per shell, LevelShellMesh::shared_pins

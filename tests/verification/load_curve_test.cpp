@@ -65,8 +65,9 @@ TEST(CantileverEndShear, OneRunTracesTheCurveAtTheRampedLoads) {
 }
 
 // Mid-edge bending on a strip bent along its grid lines: docs/verification.md gives 2 % at 8
-// cells across for the analytic roll-up (first order in the mesh). The scene's mesh has 8 cells
-// across. Measured errors are printed for the docs' table.
+// cells across (first order in the mesh). The scene's mesh has 8 cells across; measured, W is
+// 1.0–2.0 % too large (1.97 % at the first point, where the reference's three digits are worth
+// 0.08 %), −U within 0.85 % of W. Errors are printed for the docs' table.
 TEST(CantileverEndShear, TipDisplacementsMeetThePublishedCurve) {
   for (std::size_t k = 0; k < curve().size(); ++k) {
     const double deflection = -curve()[k].tip.z(), shortening = -curve()[k].tip.x();
@@ -81,14 +82,16 @@ TEST(CantileverEndShear, TipDisplacementsMeetThePublishedCurve) {
   }
 }
 
-// The clamp carries the applied load: at each equilibrium its reaction is the end force.
+// The clamp carries the applied load: at each equilibrium its reaction is the end force. The
+// frames settle to ‖d‖∞/Δt < 1e-3 (the default tolerance); measured, the reaction is within
+// 2.1e-5 of the force (relative) at every frame.
 TEST(CantileverEndShear, TheClampCarriesTheRampedEndForce) {
   for (std::size_t k = 0; k < curve().size(); ++k) {
     const double force = kMaxLoad * (k + 1) / 20.0;
     const Eigen::Vector3d& reaction = curve()[k].clamp;
-    EXPECT_NEAR(reaction.z(), -force, 1e-3 * force) << "frame " << k + 1;
-    EXPECT_NEAR(reaction.x(), 0.0, 1e-3 * force) << "frame " << k + 1;
-    EXPECT_NEAR(reaction.y(), 0.0, 1e-3 * force) << "frame " << k + 1;
+    EXPECT_NEAR(reaction.z(), -force, 1e-4 * force) << "frame " << k + 1;
+    EXPECT_NEAR(reaction.x(), 0.0, 1e-4 * force) << "frame " << k + 1;
+    EXPECT_NEAR(reaction.y(), 0.0, 1e-4 * force) << "frame " << k + 1;
   }
 }
 
