@@ -24,6 +24,9 @@ std::string method_label(const JobReport& job) {
   return job.job.depth == 1 ? "direct" : fmt::format("progressive, {} levels", job.job.depth);
 }
 
+/// A probe plot leaves out a component that stays below this fraction of the largest magnitude.
+constexpr double kNegligibleComponent = 1e-9;
+
 /// Convergence plots of longer solves are drawn as lines without point markers.
 constexpr std::size_t kMaxMarkedIterations = 60;
 
@@ -217,20 +220,25 @@ std::vector<PlotSpec> probe_plots(const JobReport& job) {
     plot.y_label = kind == "reaction" ? "reaction (N)" : "mean displacement (m)";
     std::array<PlotSeries, 4> series{PlotSeries{"x", {}, {}}, PlotSeries{"y", {}, {}},
                                      PlotSeries{"z", {}, {}}, PlotSeries{"magnitude", {}, {}}};
-    std::array<bool, 3> nonzero{false, false, false};
+    std::array<double, 3> largest{0, 0, 0};  // per component, the largest |value|
+    double largest_magnitude = 0;
     for (const db::FrameReadings& frame : frames)
       for (const db::ProbeValue& value : frame.probes) {
         if (value.probe != name) continue;
         double squares = 0;
         for (int c = 0; c < 3; ++c) {
           series[c].points.emplace_back(frame.load_scale, value.value[c]);
-          nonzero[c] = nonzero[c] || value.value[c] != 0.0;
+          largest[c] = std::max(largest[c], std::abs(value.value[c]));
           squares += value.value[c] * value.value[c];
         }
         series[3].points.emplace_back(frame.load_scale, std::sqrt(squares));
+        largest_magnitude = std::max(largest_magnitude, std::sqrt(squares));
       }
+    // A component at round-off (a symmetric strip's sideways displacement) would only crowd
+    // the plot.
     for (int c = 0; c < 3; ++c)
-      if (nonzero[c]) plot.series.push_back(std::move(series[c]));
+      if (largest[c] > kNegligibleComponent * largest_magnitude)
+        plot.series.push_back(std::move(series[c]));
     plot.series.push_back(std::move(series[3]));
     if (has_drawable_points(plot)) plots.push_back(std::move(plot));
   }
