@@ -159,6 +159,18 @@ std::optional<std::string> selection_value(const JobSelection& which) {
   return which.name();
 }
 
+/// `SELECT <columns> FROM <table>` restricted to the rows of the jobs `which` selects, ordered
+/// by `order`, prepared and bound: the per-job tables that results() reads.
+Statement rows_of_jobs(SqliteConnection& connection, const std::string& columns,
+                       const std::string& table, const std::string& order,
+                       const JobSelection& which) {
+  auto rows = connection.prepare(fmt::format(
+      "SELECT {} FROM {} WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) ORDER BY {}",
+      columns, table, selection_condition(which), order));
+  rows.bind_all(selection_value(which));
+  return rows;
+}
+
 void validate_new_job(const std::string& sweep, const NewJob& job) {
   const auto fail = [&](const std::string& problem) {
     throw InputError(fmt::format("sweep '{}': job {}: {}", sweep, job.id, problem));
@@ -403,19 +415,13 @@ void JobStore::read_frames(const JobSelection& which, std::vector<JobResult>& re
     const auto found = level_of.find({job, level});
     return found == level_of.end() ? nullptr : found->second;
   };
-  auto frames = connection_.prepare(fmt::format(
-      "SELECT job_id, level, frame, load_scale FROM frames WHERE job_id IN (SELECT jobs.id FROM "
-      "jobs WHERE {}) ORDER BY job_id, level, frame",
-      selection_condition(which)));
-  frames.bind_all(selection_value(which));
+  auto frames = rows_of_jobs(connection_, "job_id, level, frame, load_scale", "frames",
+                             "job_id, level, frame", which);
   while (frames.step())
     if (LevelRecord* level = level_record(frames.text(0), static_cast<int>(frames.integer(1))))
       level->frames.push_back({static_cast<int>(frames.integer(2)), frames.real(3), {}});
-  auto probes = connection_.prepare(fmt::format(
-      "SELECT job_id, level, frame, probe, kind, x, y, z FROM probe_readings WHERE job_id IN "
-      "(SELECT jobs.id FROM jobs WHERE {}) ORDER BY job_id, level, frame, probe",
-      selection_condition(which)));
-  probes.bind_all(selection_value(which));
+  auto probes = rows_of_jobs(connection_, "job_id, level, frame, probe, kind, x, y, z",
+                             "probe_readings", "job_id, level, frame, probe", which);
   while (probes.step()) {
     LevelRecord* level = level_record(probes.text(0), static_cast<int>(probes.integer(1)));
     if (!level) continue;
@@ -674,18 +680,12 @@ std::vector<JobResult> JobStore::results(const JobSelection& which) {
     index_of[job.id] = results.size();
     results.push_back({std::move(job), {}, {}});
   }
-  auto levels = connection_.prepare(fmt::format(
-      "SELECT job_id, {} FROM levels WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) "
-      "ORDER BY job_id, level",
-      kLevelColumns, selection_condition(which)));
-  levels.bind_all(selection_value(which));
+  auto levels = rows_of_jobs(connection_, fmt::format("job_id, {}", kLevelColumns), "levels",
+                             "job_id, level", which);
   while (levels.step())
     results[index_of.at(levels.text(0))].levels.push_back(read_level(levels, 1));
-  auto uses = connection_.prepare(fmt::format(
-      "SELECT job_id, cache_key, hit, seconds, attempt FROM hierarchy_cache_uses WHERE job_id IN "
-      "(SELECT jobs.id FROM jobs WHERE {}) ORDER BY job_id, attempt, position",
-      selection_condition(which)));
-  uses.bind_all(selection_value(which));
+  auto uses = rows_of_jobs(connection_, "job_id, cache_key, hit, seconds, attempt",
+                           "hierarchy_cache_uses", "job_id, attempt, position", which);
   while (uses.step())
     results[index_of.at(uses.text(0))].hierarchy_uses.push_back(
         {uses.text(1), uses.integer(2) != 0, uses.real(3), uses.integer(4)});

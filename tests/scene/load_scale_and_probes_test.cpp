@@ -9,6 +9,7 @@
 #include "engine/core/error.hpp"
 #include "engine/scene/load_scale.hpp"
 #include "engine/scene/scene_reader.hpp"
+#include "support/scene_error.hpp"
 #include "support/test_paths.hpp"
 
 namespace psq {
@@ -134,17 +135,9 @@ TEST(ReadLoadScaleAndProbes, BadEntriesNameTheirFileLineAndKey) {
   int index = 0;
   for (const auto& [text, line, fragment] : cases) {
     const bool before = text.starts_with("[load_scale]");
-    const std::string scene = before ? text + "\n" + kShellLines : kShellLines + text + "\n";
-    const fs::path path = test::write_file(dir / fmt::format("case{}.toml", index++), scene);
-    try {
-      read_scene(path);
-      ADD_FAILURE() << "no error for:\n" << text;
-    } catch (const InputError& e) {
-      const std::string message = e.what();
-      EXPECT_EQ(message.rfind(fmt::format("{}:{}: ", path.string(), line), 0), 0u) << message;
-      EXPECT_NE(message.find(fragment), std::string::npos)
-          << "'" << fragment << "' not in: " << message;
-    }
+    test::expect_scene_error(dir / fmt::format("case{}.toml", index++),
+                             before ? text + "\n" + kShellLines : kShellLines + text + "\n", line,
+                             fragment);
   }
 }
 
