@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "engine/core/error.hpp"
 #include "engine/sim/quasistatic.hpp"
 #include "support/library_scene.hpp"
 
@@ -88,6 +89,22 @@ TEST(Probes, ADisplacementProbeIsTheMeanDisplacementOfItsVertices) {
   EXPECT_LT((tip - sum / count).norm(), 1e-15) << tip.transpose();
   EXPECT_LT(tip.z(), 0.0);  // it bends down, under the load
   EXPECT_EQ(reading(record, "tip").kind, ProbeKind::displacement);
+}
+
+TEST(Probes, APinWhoseComponentsEarlierPinsAllFixHasNoReactionAndIsRefused) {
+  Scene scene = keyframed_cantilever();
+  PinnedSet shadow = scene.shells[0].pins.at(0);  // the clamp again: every component is taken
+  shadow.name = "shadow";
+  scene.shells[0].pins.push_back(shadow);
+  scene.shells[0].probes = {{.name = "shadow_force", .kind = ProbeKind::reaction, .pin = "shadow"}};
+  try {
+    QuasistaticSimulation sim(scene);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("probe 'shadow_force' of shell 'strip'"), std::string::npos) << message;
+    EXPECT_NE(message.find("probe the pin that fixes them"), std::string::npos) << message;
+  }
 }
 
 }  // namespace
