@@ -110,6 +110,23 @@ struct Claim {
   Lease lease;
 };
 
+/// A probe's reading at one frame (engine/sim/probes.hpp): `kind` "displacement", the mean
+/// displacement of a vertex selection [m], or "reaction", the force a pinned set carries [N].
+struct ProbeValue {
+  std::string probe;  ///< the probe's name in the scene
+  std::string kind;
+  std::array<double, 3> value{};
+  bool operator==(const ProbeValue&) const = default;
+};
+
+/// One frame of a level: the scale of its loads and its probes' readings at its answer.
+struct FrameReadings {
+  int frame = 0;  ///< 1-based
+  double load_scale = 1;
+  std::vector<ProbeValue> probes;
+  bool operator==(const FrameReadings&) const = default;
+};
+
 /// The record of one hierarchy level of a job.
 struct LevelRecord {
   int level = 0;  ///< 0 = coarsest; depth − 1 = finest
@@ -125,6 +142,11 @@ struct LevelRecord {
   std::map<std::string, double> refinement;
   /// What the finished level computed, by name (db::kLevelOutputs); empty unless done.
   std::map<std::string, double> outputs;
+  /// Frames with their load scale and probe readings. Written: the frames solved since the
+  /// level's last record, each replacing a stored row of its frame (a frame solved again after
+  /// a resume, or a settling step of a frame already recorded); read: every stored frame of
+  /// the level, in frame order.
+  std::vector<FrameReadings> frames;
   std::string checkpoint_path;            ///< empty if none
   std::string checkpoint_checksum;        ///< of the checkpoint file; empty if none
   std::string error;                      ///< empty unless failed

@@ -159,6 +159,18 @@ std::optional<std::string> selection_value(const JobSelection& which) {
   return which.name();
 }
 
+/// `SELECT <columns> FROM <table>` restricted to the rows of the jobs `which` selects, ordered
+/// by `order`, prepared and bound: the per-job tables that results() reads.
+Statement rows_of_jobs(SqliteConnection& connection, const std::string& columns,
+                       const std::string& table, const std::string& order,
+                       const JobSelection& which) {
+  auto rows = connection.prepare(fmt::format(
+      "SELECT {} FROM {} WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) ORDER BY {}",
+      columns, table, selection_condition(which), order));
+  rows.bind_all(selection_value(which));
+  return rows;
+}
+
 void validate_new_job(const std::string& sweep, const NewJob& job) {
   const auto fail = [&](const std::string& problem) {
     throw InputError(fmt::format("sweep '{}': job {}: {}", sweep, job.id, problem));
@@ -374,8 +386,52 @@ void JobStore::record_level(const Lease& lease, const LevelRecord& level) {
                 nlohmann::json(level.static_residuals).dump(),
                 named_numbers_json(level.refinement), named_numbers_json(level.outputs))
       .run();
+  write_frames(lease.job_id, level);
   if (options_.inside_record_transaction) options_.inside_record_transaction();
   transaction.commit();
+}
+
+void JobStore::write_frames(const std::string& job_id, const LevelRecord& level) {
+  auto frame = connection_.prepare(
+      "REPLACE INTO frames (job_id, level, frame, load_scale) VALUES (?1, ?2, ?3, ?4)");
+  auto probe = connection_.prepare(
+      "REPLACE INTO probe_readings (job_id, level, frame, probe, kind, x, y, z) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+  for (const FrameReadings& readings : level.frames) {
+    frame.reset().bind_all(job_id, level.level, readings.frame, readings.load_scale).run();
+    for (const ProbeValue& value : readings.probes)
+      probe.reset()
+          .bind_all(job_id, level.level, readings.frame, value.probe, value.kind, value.value[0],
+                    value.value[1], value.value[2])
+          .run();
+  }
+}
+
+void JobStore::read_frames(const JobSelection& which, std::vector<JobResult>& results) {
+  std::map<std::pair<std::string, int>, LevelRecord*> level_of;
+  for (JobResult& result : results)
+    for (LevelRecord& level : result.levels) level_of[{result.job.id, level.level}] = &level;
+  const auto level_record = [&](const std::string& job, int level) -> LevelRecord* {
+    const auto found = level_of.find({job, level});
+    return found == level_of.end() ? nullptr : found->second;
+  };
+  auto frames = rows_of_jobs(connection_, "job_id, level, frame, load_scale", "frames",
+                             "job_id, level, frame", which);
+  while (frames.step())
+    if (LevelRecord* level = level_record(frames.text(0), static_cast<int>(frames.integer(1))))
+      level->frames.push_back({static_cast<int>(frames.integer(2)), frames.real(3), {}});
+  auto probes = rows_of_jobs(connection_, "job_id, level, frame, probe, kind, x, y, z",
+                             "probe_readings", "job_id, level, frame, probe", which);
+  while (probes.step()) {
+    LevelRecord* level = level_record(probes.text(0), static_cast<int>(probes.integer(1)));
+    if (!level) continue;
+    const int number = static_cast<int>(probes.integer(2));
+    const auto frame = std::find_if(level->frames.begin(), level->frames.end(),
+                                    [&](const FrameReadings& f) { return f.frame == number; });
+    if (frame == level->frames.end()) continue;
+    frame->probes.push_back(
+        {probes.text(3), probes.text(4), {probes.real(5), probes.real(6), probes.real(7)}});
+  }
 }
 
 void JobStore::record_hierarchy_uses(const Lease& lease,
@@ -624,21 +680,16 @@ std::vector<JobResult> JobStore::results(const JobSelection& which) {
     index_of[job.id] = results.size();
     results.push_back({std::move(job), {}, {}});
   }
-  auto levels = connection_.prepare(fmt::format(
-      "SELECT job_id, {} FROM levels WHERE job_id IN (SELECT jobs.id FROM jobs WHERE {}) "
-      "ORDER BY job_id, level",
-      kLevelColumns, selection_condition(which)));
-  levels.bind_all(selection_value(which));
+  auto levels = rows_of_jobs(connection_, fmt::format("job_id, {}", kLevelColumns), "levels",
+                             "job_id, level", which);
   while (levels.step())
     results[index_of.at(levels.text(0))].levels.push_back(read_level(levels, 1));
-  auto uses = connection_.prepare(fmt::format(
-      "SELECT job_id, cache_key, hit, seconds, attempt FROM hierarchy_cache_uses WHERE job_id IN "
-      "(SELECT jobs.id FROM jobs WHERE {}) ORDER BY job_id, attempt, position",
-      selection_condition(which)));
-  uses.bind_all(selection_value(which));
+  auto uses = rows_of_jobs(connection_, "job_id, cache_key, hit, seconds, attempt",
+                           "hierarchy_cache_uses", "job_id, attempt, position", which);
   while (uses.step())
     results[index_of.at(uses.text(0))].hierarchy_uses.push_back(
         {uses.text(1), uses.integer(2) != 0, uses.real(3), uses.integer(4)});
+  read_frames(which, results);
   return results;
 }
 

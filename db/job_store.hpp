@@ -138,6 +138,11 @@ class JobStore {
   /// Throws LeaseLostError unless the job is running with the lease's attempt; returns its
   /// depth.
   int check_lease(const Lease& lease);
+  /// Writes level.frames of the job, each replacing its frame's rows (inside record_level's
+  /// transaction).
+  void write_frames(const std::string& job_id, const LevelRecord& level);
+  /// Adds to each level of `results` (the jobs of `which`) its stored frames, in frame order.
+  void read_frames(const JobSelection& which, std::vector<JobResult>& results);
   /// Throws InputError if the selection names a sweep or job that is not stored.
   void check_selection_exists(const JobSelection& which);
   /// In one immediate transaction, after check_selection_exists: runs `update` (an UPDATE of

@@ -186,6 +186,30 @@ CREATE TABLE hierarchy_cache_uses (
 CREATE INDEX hierarchy_cache_uses_by_key ON hierarchy_cache_uses (cache_key);
 )sql";
 
+// Per frame of each level, the scale of its loads, and per probe its reading there (a vector:
+// a mean displacement or the reaction of a pinned set): load–displacement curves from one run.
+// Rows refer to the job, not the level row, which record_level replaces.
+constexpr const char* kFrameProbes = R"sql(
+CREATE TABLE frames (
+  job_id     TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+  level      INTEGER NOT NULL CHECK (level >= 0),
+  frame      INTEGER NOT NULL CHECK (frame >= 1),
+  load_scale REAL NOT NULL,
+  PRIMARY KEY (job_id, level, frame)
+) WITHOUT ROWID;
+CREATE TABLE probe_readings (
+  job_id TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+  level  INTEGER NOT NULL CHECK (level >= 0),
+  frame  INTEGER NOT NULL CHECK (frame >= 1),
+  probe  TEXT NOT NULL,
+  kind   TEXT NOT NULL CHECK (kind IN ('displacement', 'reaction')),
+  x      REAL NOT NULL,
+  y      REAL NOT NULL,
+  z      REAL NOT NULL,
+  PRIMARY KEY (job_id, level, frame, probe)
+) WITHOUT ROWID;
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
@@ -196,6 +220,7 @@ constexpr std::array kMigrations{
     Migration{6, "coarse-first sweeps: previewed jobs, level outputs, refine rules", kCoarseFirst,
               true},
     Migration{7, "hierarchy cache uses: hits, builds and their seconds", kHierarchyCacheUses},
+    Migration{8, "per-frame load scale and probe readings", kFrameProbes},
 };
 
 constexpr const char* kVersionTable = R"sql(

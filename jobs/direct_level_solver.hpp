@@ -28,6 +28,17 @@ inline std::vector<PartRange> system_parts(const ShellSystem& system) {
   return parts;
 }
 
+/// A solved frame's load scale and probe readings, for the store.
+inline db::FrameReadings frame_readings(const FrameRecord& record) {
+  db::FrameReadings readings{.frame = record.frame, .load_scale = record.load_scale, .probes = {}};
+  for (const ProbeReading& probe : record.probes)
+    readings.probes.push_back(
+        {.probe = probe.name,
+         .kind = probe.kind == ProbeKind::displacement ? "displacement" : "reaction",
+         .value = {probe.value.x(), probe.value.y(), probe.value.z()}});
+  return readings;
+}
+
 /// A direct solve as a hierarchy of one level: QuasistaticSimulation over the scene's frames.
 class DirectLevelSolver final : public LevelSolver {
  public:
@@ -52,7 +63,8 @@ class DirectLevelSolver final : public LevelSolver {
             .elastic_energy = record.elastic_energy,
             // The record says only that the step or its settling ran out of iterations.
             .failure = {},
-            .times = record.newton.times};
+            .times = record.newton.times,
+            .readings = frame_readings(record)};
   }
 
   void refine(const RefinementPhase&) override {
@@ -107,7 +119,8 @@ class ProgressiveLevelSolver final : public LevelSolver {
             .gradient_norm = newton.gradient_norm,
             .elastic_energy = step.frame.elastic_energy,
             .failure = step.settling_failure,
-            .times = newton.times};
+            .times = newton.times,
+            .readings = frame_readings(step.frame)};
   }
   void refine(const RefinementPhase& phase) override { simulation_.refine(phase); }
   std::map<std::string, double> refinement_statistics() const override {

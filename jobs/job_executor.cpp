@@ -275,6 +275,7 @@ class JobRun {
           solver_->step([this](int frame, const NewtonIteration& it) { on_iteration(frame, it); });
       resumed_in_frame_.reset();
       frame_energy_ = frame.elastic_energy;
+      add_unrecorded(frame.readings);
       if (frame.must_converge && frame.stagnated)
         throw NotConverged(fmt::format(
             "level {} frame {} stagnated at round-off at ‖Δx‖∞/Δt = {:.3e}: solver.tolerance is "
@@ -295,6 +296,15 @@ class JobRun {
         write(file, make_checkpoint(LevelProgress::level_done, solver_->frame(), 0));
     test_point("level_written");
     record_finished_level(file, checksum);
+  }
+
+  /// A frame's readings, to go with the level's next record; a settling step of the frame last
+  /// added replaces its readings (the frame's answer is its last step's).
+  void add_unrecorded(const db::FrameReadings& readings) {
+    if (!unrecorded_frames_.empty() && unrecorded_frames_.back().frame == readings.frame)
+      unrecorded_frames_.back() = readings;
+    else
+      unrecorded_frames_.push_back(readings);
   }
 
   void on_iteration(int frame, const NewtonIteration& it) {
@@ -448,8 +458,10 @@ class JobRun {
       level.checkpoint_checksum = checksum_text(checksum);
     }
     level.error = error;
+    level.frames = unrecorded_frames_;
     test_point("record_level");
     through_store([&] { store_.record_level(claim_.lease, level); });
+    unrecorded_frames_.clear();
     statistics_.timings["database"] += seconds_since(start);
   }
 
@@ -560,6 +572,8 @@ class JobRun {
   int iterations_since_checkpoint_ = 0;
   /// (frame, iterations done) of a frame restored in progress, until its next step.
   std::optional<std::pair<int, int>> resumed_in_frame_;
+  /// The readings of the current level's frames solved since its last record.
+  std::vector<db::FrameReadings> unrecorded_frames_;
   /// Elastic energy of the last solved frame of this level (the reports' energy output).
   std::optional<double> frame_energy_;
 };

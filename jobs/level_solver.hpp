@@ -33,6 +33,8 @@ struct LevelFrame {
   /// budget ran out" (a settling that stalled); empty otherwise.
   std::string failure;
   PhaseTimes times;             ///< of this step() call
+  /// The frame's load scale and its probe readings (none below the finest level).
+  db::FrameReadings readings;
 };
 
 class LevelSolver {

@@ -84,6 +84,7 @@ struct PagePlots {
   std::vector<std::size_t> cost;   ///< time per level, error against run time
   std::vector<std::size_t> sweep;  ///< outputs against the axis parameter
   std::map<int, std::vector<std::size_t>> convergence;  ///< by job number, one per level
+  std::map<int, std::vector<std::size_t>> probes;  ///< by job number, one per probe
 };
 
 PagePlots collect_plots(const SweepReport& report, PlotFigures& plots) {
@@ -92,9 +93,12 @@ PagePlots collect_plots(const SweepReport& report, PlotFigures& plots) {
     if (has_drawable_points(plot)) page.cost.push_back(plots.add(std::move(plot)));
   for (PlotSpec& plot : sweep_plots(report)) page.sweep.push_back(plots.add(std::move(plot)));
   for (const JobReport& job : report.jobs)
-    if (job.finished())
+    if (job.finished()) {
       for (PlotSpec& plot : convergence_plots(job))
         page.convergence[job.number].push_back(plots.add(std::move(plot)));
+      for (PlotSpec& plot : probe_plots(job))
+        page.probes[job.number].push_back(plots.add(std::move(plot)));
+    }
   return page;
 }
 
@@ -215,14 +219,15 @@ std::string job_section(const JobReport& job, const PagePlots& page, const PlotF
   for (const auto& [name, value] : job.parameters)
     parameters += fmt::format("{}<code>{}</code> = {}", parameters.empty() ? "" : "<br>",
                               escape_html(name), escape_html(cell_text(value)));
-  std::string convergence;
-  if (const auto found = page.convergence.find(job.number); found != page.convergence.end())
-    convergence = figure_row(plots.figures(found->second));
+  const auto figures_of = [&](const std::map<int, std::vector<std::size_t>>& plotted) {
+    const auto found = plotted.find(job.number);
+    return found == plotted.end() ? std::string() : figure_row(plots.figures(found->second));
+  };
   const std::string shapes = shape_figures(job);
   return fmt::format(
-      "<h2 id=\"job-{0}\">Job #{0}</h2>\n<p>id <code>{1}</code><br>{2}</p>\n{3}{4}",
-      job.number, escape_html(job.job.id), parameters, convergence,
-      shapes.empty() ? std::string() : figure_row(shapes));
+      "<h2 id=\"job-{0}\">Job #{0}</h2>\n<p>id <code>{1}</code><br>{2}</p>\n{3}{4}{5}",
+      job.number, escape_html(job.job.id), parameters, figures_of(page.convergence),
+      figures_of(page.probes), shapes.empty() ? std::string() : figure_row(shapes));
 }
 
 }  // namespace

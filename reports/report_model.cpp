@@ -53,6 +53,7 @@ LevelReport level_from_record(const db::LevelRecord& record) {
     level.static_residual = record.static_residuals.back().second;
   level.refinement = record.refinement;
   level.outputs = record.outputs;
+  level.frames = record.frames;
   level.checkpoint = record.checkpoint_path;
   level.error = record.error;
   return level;

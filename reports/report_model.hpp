@@ -58,6 +58,8 @@ struct LevelReport {
   std::map<std::string, double> refinement;
   /// What the level computed, as stored (db::kLevelOutputs); empty unless done.
   std::map<std::string, double> outputs;
+  /// The level's frames with their load scale and probe readings, as stored, in frame order.
+  std::vector<db::FrameReadings> frames;
   /// The level's Newton solves in order, from its checkpoint (levels with a shape only).
   std::vector<NewtonSolve> solves;
   std::string checkpoint;           ///< as recorded in the store; empty if none

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <functional>
 #include <set>
 
@@ -21,6 +23,9 @@ std::string job_label(const JobReport& job) { return fmt::format("#{}", job.numb
 std::string method_label(const JobReport& job) {
   return job.job.depth == 1 ? "direct" : fmt::format("progressive, {} levels", job.job.depth);
 }
+
+/// A probe plot leaves out a component that stays below this fraction of the largest magnitude.
+constexpr double kNegligibleComponent = 1e-9;
 
 /// Convergence plots of longer solves are drawn as lines without point markers.
 constexpr std::size_t kMaxMarkedIterations = 60;
@@ -192,6 +197,49 @@ std::vector<PlotSpec> convergence_plots(const JobReport& job) {
         series.points.emplace_back(static_cast<double>(i), solve.residuals[i]);
       plot.series.push_back(std::move(series));
     }
+    if (has_drawable_points(plot)) plots.push_back(std::move(plot));
+  }
+  return plots;
+}
+
+std::vector<PlotSpec> probe_plots(const JobReport& job) {
+  std::vector<PlotSpec> plots;
+  if (job.levels.empty()) return plots;
+  const std::vector<db::FrameReadings>& frames = job.levels.back().frames;
+  // The probes in the order of their first reading.
+  std::vector<std::pair<std::string, std::string>> probes;  // (name, kind)
+  for (const db::FrameReadings& frame : frames)
+    for (const db::ProbeValue& value : frame.probes)
+      if (std::none_of(probes.begin(), probes.end(),
+                       [&](const auto& p) { return p.first == value.probe; }))
+        probes.emplace_back(value.probe, value.kind);
+  for (const auto& [name, kind] : probes) {
+    PlotSpec plot;
+    plot.title = fmt::format("job {}: probe '{}' against the load scale", job_label(job), name);
+    plot.x_label = "load scale";
+    plot.y_label = kind == "reaction" ? "reaction (N)" : "mean displacement (m)";
+    std::array<PlotSeries, 4> series{PlotSeries{"x", {}, {}}, PlotSeries{"y", {}, {}},
+                                     PlotSeries{"z", {}, {}}, PlotSeries{"magnitude", {}, {}}};
+    std::array<double, 3> largest{0, 0, 0};  // per component, the largest |value|
+    double largest_magnitude = 0;
+    for (const db::FrameReadings& frame : frames)
+      for (const db::ProbeValue& value : frame.probes) {
+        if (value.probe != name) continue;
+        double squares = 0;
+        for (int c = 0; c < 3; ++c) {
+          series[c].points.emplace_back(frame.load_scale, value.value[c]);
+          largest[c] = std::max(largest[c], std::abs(value.value[c]));
+          squares += value.value[c] * value.value[c];
+        }
+        series[3].points.emplace_back(frame.load_scale, std::sqrt(squares));
+        largest_magnitude = std::max(largest_magnitude, std::sqrt(squares));
+      }
+    // A component at round-off (a symmetric strip's sideways displacement) would only crowd
+    // the plot.
+    for (int c = 0; c < 3; ++c)
+      if (largest[c] > kNegligibleComponent * largest_magnitude)
+        plot.series.push_back(std::move(series[c]));
+    plot.series.push_back(std::move(series[3]));
     if (has_drawable_points(plot)) plots.push_back(std::move(plot));
   }
   return plots;

@@ -15,6 +15,12 @@ namespace psq::reports {
 /// in order. Levels without solves have no plot.
 std::vector<PlotSpec> convergence_plots(const JobReport& job);
 
+/// Per probe of the job's finest level, its reading against the load scale, frame by frame: the
+/// components that are not negligible (below 1e-9 of the largest magnitude at every frame) and
+/// the magnitude, one curve each; metres for a displacement probe, newtons for a reaction. No
+/// plots without probe readings.
+std::vector<PlotSpec> probe_plots(const JobReport& job);
+
 /// Seconds per level against the level, log scale, one curve per finished job.
 PlotSpec time_per_level_plot(const SweepReport& report);
 

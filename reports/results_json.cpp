@@ -9,6 +9,18 @@ nlohmann::json number_or_null(std::optional<double> value) {
   return value && std::isfinite(*value) ? nlohmann::json(*value) : nlohmann::json();
 }
 
+/// The level's frames: load scale and probe readings ({name, kind, value [x, y, z]}).
+nlohmann::json frames_json(const std::vector<db::FrameReadings>& frames) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const db::FrameReadings& frame : frames) {
+    nlohmann::json probes = nlohmann::json::array();
+    for (const db::ProbeValue& probe : frame.probes)
+      probes.push_back({{"name", probe.probe}, {"kind", probe.kind}, {"value", probe.value}});
+    out.push_back({{"frame", frame.frame}, {"load_scale", frame.load_scale}, {"probes", probes}});
+  }
+  return out;
+}
+
 nlohmann::json level_json(const LevelReport& level) {
   nlohmann::json residuals = nlohmann::json::array();
   for (double residual : level.residuals) residuals.push_back(number_or_null(residual));
@@ -25,6 +37,7 @@ nlohmann::json level_json(const LevelReport& level) {
           {"static_residuals", static_residuals},
           {"error_to_finest", number_or_null(level.error_to_finest)},
           {"refinement", level.refinement},
+          {"frames", frames_json(level.frames)},
           {"checkpoint", level.checkpoint},
           {"error", level.error},
           {"residuals", residuals}};

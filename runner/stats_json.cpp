@@ -32,6 +32,16 @@ nlohmann::json contact_json(const FrameRecord& r) {
           {"ccd_seconds", c.ccd_seconds}};
 }
 
+nlohmann::json probes_json(const std::vector<ProbeReading>& readings) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ProbeReading& reading : readings)
+    out.push_back({{"name", reading.name},
+                   {"kind", reading.kind == ProbeKind::displacement ? "displacement" : "reaction"},
+                   {"value", {reading.value.x(), reading.value.y(), reading.value.z()}},
+                   {"magnitude", reading.value.norm()}});
+  return out;
+}
+
 nlohmann::json frame_json(const FrameRecord& r) {
   nlohmann::json step_norms = nlohmann::json::array();
   nlohmann::json gradient_norms = nlohmann::json::array();
@@ -54,6 +64,8 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"static_residual", std::isnan(r.static_residual) ? nlohmann::json(nullptr)
                                                             : nlohmann::json(r.static_residual)},
           {"friction_iterations", r.friction_iterations},
+          {"load_scale", r.load_scale},
+          {"probes", probes_json(r.probes)},
           {"contact", contact_json(r)},
           {"seconds", r.newton.wall_seconds},
           {"phase_seconds", phase_times_json(r.newton.times)}};

@@ -312,6 +312,8 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   const double time_step = out.settling
                                ? settling_time_step(finest_.scene().time.step, settle_growth_)
                                : finest_.scene().time.step;
+  // Every level's external force is the finest system's (ProxyElastics), at the frame's loading.
+  finest_.set_load_time(frame * finest_.scene().time.step);
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   const int iterations_done = std::exchange(resumed_iterations_, 0);
   if (iterations_done == 0) previous_ = x_;

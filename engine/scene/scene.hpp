@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/elastic/bending_model.hpp"
@@ -79,6 +80,24 @@ struct Load {
 /// A shell's strain limit (the `strain_limit` keys of its material table): no principal
 /// stretch of any of its triangles may reach `limit` (C-IPC strain limiting,
 /// docs/friction-and-strain-limiting.md).
+/// What a probe records at every frame (docs/scene-format.md, `[[shell.probe]]`).
+enum class ProbeKind {
+  /// The mean displacement x − X over a vertex selection [m].
+  displacement,
+  /// The force a pinned set's vertices exert on what holds them, summed over the components the
+  /// set fixes [N] (engine/sim/probes.hpp derives it and its sign).
+  reaction,
+};
+
+/// A named quantity of one shell recorded per frame: the mean displacement of a selection, or
+/// the reaction of one of the shell's pinned sets.
+struct Probe {
+  std::string name;  ///< unique among the scene's probes
+  ProbeKind kind = ProbeKind::displacement;
+  VertexSelector selector;  ///< ProbeKind::displacement
+  std::string pin;          ///< ProbeKind::reaction: the name of one of the shell's pins
+};
+
 struct StrainLimitSettings {
   double limit = 1.05;  ///< s̄ > 1, the largest principal stretch approached
   /// κ_s [N/m] to start from (doubled while the barrier loses); unset: E h δ²
@@ -94,6 +113,16 @@ struct Shell {
   std::optional<StrainLimitSettings> strain_limit;  ///< none: the shell stretches freely
   std::vector<PinnedSet> pins;
   std::vector<Load> loads;
+  std::vector<Probe> probes;
+};
+
+/// How every load's force (the [[shell.load]] forces; gravity is not scaled) scales with time:
+/// s(t) piecewise linear through the keyframes (t_i, s_i), times strictly increasing, constant
+/// before the first keyframe and after the last. A ramp from 0 at `start` to 1 at `end` is the
+/// keyframes (start, 0), (end, 1): the same s(t) as a pin motion's (RigidMotion), which a jump
+/// (end = start) is too: s = 0 before the time and 1 from it on.
+struct LoadScale {
+  std::vector<std::pair<double, double>> keyframes{{0.0, 1.0}};  ///< the default: s = 1
 };
 
 struct TimeStepping {
@@ -180,6 +209,7 @@ struct Scene {
   std::vector<Shell> shells;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< [m/s²]
   TimeStepping time;
+  LoadScale load_scale;
   SolverSettings solver;
   HierarchyOptions hierarchy;
   ContactSettings contact;

@@ -222,6 +222,12 @@ class Section {
       std::vector<std::string> out;
       for (const toml::node& element : *array) out.push_back(convert<std::string>(key, element));
       return out;
+    } else if constexpr (std::is_same_v<T, std::vector<Eigen::Vector2d>>) {
+      const toml::array* array = node.as_array();
+      if (!array) wrong_type(key, node, "an array of [a, b] pairs of numbers");
+      std::vector<Eigen::Vector2d> out;
+      for (const toml::node& element : *array) out.push_back(to_vector<2>(key, element));
+      return out;
     } else if constexpr (std::is_same_v<T, std::vector<int>>) {
       const toml::array* array = node.as_array();
       if (!array) wrong_type(key, node, "an array of integers");
@@ -641,6 +647,38 @@ Load read_load(const Section& section) {
   return load;
 }
 
+/// A [[shell.probe]]: a name and either a vertex selector (the selection's mean displacement)
+/// or `pin`, the name of one of `pins` (that set's reaction).
+Probe read_probe(const Section& section, const std::vector<PinnedSet>& pins) {
+  section.allow_only(with_selector_keys({"name", "pin"}));
+  Probe probe;
+  probe.name = read_name(section);
+  if (!section.has("pin")) {
+    probe.selector = read_selector(section);
+    return probe;
+  }
+  for (const std::string& key : kSelectorKeys)
+    if (section.has(key))
+      section.fail(section.line(key),
+                   fmt::format("'{}' and 'pin' {} exclude each other: a probe records either a "
+                               "selection's displacement or a pin's reaction",
+                               key, section.where()));
+  probe.kind = ProbeKind::reaction;
+  probe.pin = section.get_required<std::string>("pin");
+  Keys pin_names;
+  for (const PinnedSet& pin : pins) pin_names.push_back(pin.name);
+  if (std::find(pin_names.begin(), pin_names.end(), probe.pin) == pin_names.end()) {
+    const auto suggestion = suggest_key(probe.pin, pin_names);
+    section.fail(section.line("pin"),
+                 fmt::format("unknown pin '{}' {}; {}", probe.pin, section.where(),
+                             suggestion ? fmt::format("did you mean '{}'?", *suggestion)
+                             : pin_names.empty()
+                                 ? std::string("the shell has no [[shell.pin]]")
+                                 : fmt::format("the shell's pins: {}", quoted_list(pin_names))));
+  }
+  return probe;
+}
+
 /// Fails if `name` was already used by an earlier item of the same kind.
 void check_unique_name(const Section& section, std::set<std::string>& used, const std::string& name,
                        std::string_view kind) {
@@ -650,8 +688,11 @@ void check_unique_name(const Section& section, std::set<std::string>& used, cons
                                                    kind, name));
 }
 
-Shell read_shell(const Section& section, const fs::path& scene_path) {
-  section.allow_only({"name", "mesh", "placement", "material", "bending", "pin", "load"});
+/// A [[shell]]; its probes' names join `probe_names`, the scene's (they name its outputs).
+Shell read_shell(const Section& section, const fs::path& scene_path,
+                 std::set<std::string>& probe_names) {
+  section.allow_only(
+      {"name", "mesh", "placement", "material", "bending", "pin", "load", "probe"});
   Shell shell;
   shell.name = read_name(section);
   shell.mesh = read_mesh_source(section, scene_path);
@@ -665,6 +706,10 @@ Shell read_shell(const Section& section, const fs::path& scene_path) {
     check_unique_name(pin, pin_names, shell.pins.back().name, "pin");
   }
   for (const Section& load : section.tables("load")) shell.loads.push_back(read_load(load));
+  for (const Section& probe : section.tables("probe")) {
+    shell.probes.push_back(read_probe(probe, shell.pins));
+    check_unique_name(probe, probe_names, shell.probes.back().name, "probe");
+  }
   return shell;
 }
 
@@ -679,6 +724,40 @@ TimeStepping read_time(const Section& root) {
   time.step = read_positive(*section, "step", time.step);
   time.frames = read_count(*section, "frames", time.frames);
   return time;
+}
+
+/// The [load_scale] table: a ramp from 0 at `start` to 1 at `end`, or `keyframes` [[t, s], ...]
+/// with times in non-decreasing order.
+LoadScale read_load_scale(const Section& root) {
+  LoadScale scale;
+  const auto section = root.optional_table("load_scale");
+  if (!section) return scale;
+  section->allow_only({"start", "end", "keyframes"});
+  if (!section->has("keyframes")) {
+    const double start = section->get<double>("start", 0.0);
+    const double end = section->get<double>("end", 1.0);
+    section->check(end >= start, "end",
+                   fmt::format("at least start ({:g}); got {:g}", start, end));
+    scale.keyframes = {{start, 0.0}, {end, 1.0}};
+    return scale;
+  }
+  for (const std::string key : {"start", "end"})
+    if (section->has(key))
+      section->fail(section->line(key),
+                    fmt::format("'{}' and 'keyframes' {} exclude each other: give a ramp (start, "
+                                "end) or keyframes",
+                                key, section->where()));
+  const auto keys = section->get_required<std::vector<Eigen::Vector2d>>("keyframes");
+  section->check(!keys.empty(), "keyframes", "a non-empty array of [time, scale] keyframes");
+  scale.keyframes.clear();
+  for (const Eigen::Vector2d& key : keys) {
+    if (!scale.keyframes.empty())
+      section->check(key.x() >= scale.keyframes.back().first, "keyframes",
+                     fmt::format("in time order ({:g} follows {:g})", key.x(),
+                                 scale.keyframes.back().first));
+    scale.keyframes.emplace_back(key.x(), key.y());
+  }
+  return scale;
 }
 
 SolverSettings read_solver(const Section& root) {
@@ -811,21 +890,22 @@ Scene read_scene_text(std::string_view text, const fs::path& path) {
 
 Scene read_scene_document(const toml::table& document, const fs::path& path) {
   const Section root(document, "", path.string());
-  root.allow_only(
-      {"name", "gravity", "time", "solver", "hierarchy", "contact", "shell", "collider"});
+  root.allow_only({"name", "gravity", "time", "load_scale", "solver", "hierarchy", "contact",
+                   "shell", "collider"});
   Scene scene;
   scene.source = path;
   scene.name = root.get<std::string>("name", path.stem().string());
   root.check(!scene.name.empty(), "name", "a non-empty string");
   scene.gravity = root.get<Eigen::Vector3d>("gravity", scene.gravity);
   scene.time = read_time(root);
+  scene.load_scale = read_load_scale(root);
   scene.solver = read_solver(root);
   scene.hierarchy = read_hierarchy(root, scene.time);
   const std::vector<Section> shells = root.tables("shell");
   if (shells.empty()) root.fail(0, "the scene has no shell; add at least one [[shell]] section");
-  std::set<std::string> shell_names;
+  std::set<std::string> shell_names, probe_names;
   for (const Section& shell : shells) {
-    scene.shells.push_back(read_shell(shell, path));
+    scene.shells.push_back(read_shell(shell, path, probe_names));
     check_unique_name(shell, shell_names, scene.shells.back().name, "shell");
   }
   for (const Section& collider : root.tables("collider")) {

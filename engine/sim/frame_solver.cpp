@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "engine/core/error.hpp"
+#include "engine/scene/load_scale.hpp"
 
 namespace psq {
 namespace {
@@ -241,6 +242,13 @@ void FrameSolver::solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous
 }
 
 void FrameSolver::finish_frame(const Eigen::VectorXd& x, FrameRecord& record) {
+  // The scene's, not the system's: a coarse level's loads are the finest system's.
+  record.load_scale = load_scale_at(system_.scene().load_scale, record.time);
+  if (!system_.probes().empty()) {
+    Eigen::VectorXd static_gradient;
+    potential_.static_gradient(x, static_gradient);
+    record.probes = read_probes(system_, x, static_gradient);
+  }
   if (!contact_) return;
   Eigen::VectorXd target = x;
   system_.apply_pins(target, record.time);

@@ -23,6 +23,7 @@
 #include "engine/sim/friction_term.hpp"
 #include "engine/sim/incremental_potential.hpp"
 #include "engine/sim/kinematic_pull.hpp"
+#include "engine/sim/probes.hpp"
 #include "engine/sim/shell_system.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 #include "engine/solver/newton.hpp"
@@ -57,6 +58,10 @@ struct FrameRecord {
   /// the frame start, then re-lagged at each solution until the solution settles.
   int friction_iterations = 0;
   double friction_seconds = 0;  ///< lagging and evaluating friction (within assembly, line search)
+  /// The scale of the loads at the frame's time (scene.hpp, LoadScale).
+  double load_scale = 1;
+  /// The system's probes at the frame's answer (none below the finest level).
+  std::vector<ProbeReading> probes;
 };
 
 /// Adds a solve to a frame's Newton record: iterations, history and times accumulate; the
@@ -99,8 +104,8 @@ class FrameSolver {
   void solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous,
                   const Eigen::VectorXd& frame_start, FrameRecord& record,
                   const NewtonSettings& settings, const NewtonSolver::Progress& progress);
-  /// The frame's contact statistics, κ and the scripted vertices' distance from their targets
-  /// (no-op without contact).
+  /// The frame's load scale and probe readings at x; with contact its contact statistics, κ and
+  /// the scripted vertices' distance from their targets.
   void finish_frame(const Eigen::VectorXd& x, FrameRecord& record);
 
   /// Adds the adaptive stiffnesses (κ and its range, each limited shell's κ_s and slack).

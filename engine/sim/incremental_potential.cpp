@@ -48,6 +48,11 @@ void IncrementalPotential::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g
   for (PotentialTerm* term : terms_) term->add_gradient(x, g);
 }
 
+void IncrementalPotential::static_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+  gradient(x, g);
+  g -= inertia_weight_ * system_.dof_masses().cwiseProduct(x - previous_);
+}
+
 void IncrementalPotential::hessian(const Eigen::VectorXd& x, HessianBlocks& H) {
   H.diagonal = inertia_weight_ * system_.dof_masses();
   std::size_t elastic_batches = 0;

@@ -41,6 +41,9 @@ class IncrementalPotential : public Objective {
   /// The smallest feasible step of the added terms (1 without terms).
   double max_feasible_step(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) override;
 
+  /// ∇ of everything but the inertia-like term: the static potential's gradient, whose entries
+  /// at pinned DOFs are the forces holding them (engine/sim/probes.hpp).
+  void static_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g);
   /// ∇ of the inertia, elastic and external parts alone, without the added terms.
   void base_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) const;
   /// Elastic energy alone (membrane plus bending, or the model's Ψ), for reports.

@@ -69,6 +69,7 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   FrameRecord record;
   record.frame = frame_ + 1;
   record.time = record.frame * system_.scene().time.step;
+  system_.set_load_time(record.time);
   const int resumed_iterations = std::exchange(resumed_iterations_, 0);
   const bool resumed_in_settling = resumed_iterations > 0 && settle_growth_ > 0;
   if (resumed_iterations == 0) previous_ = x_;

@@ -8,6 +8,7 @@
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
+#include "engine/scene/load_scale.hpp"
 #include "engine/scene/rigid_motion.hpp"
 #include "engine/scene/shell_mesh.hpp"
 #include "engine/scene/vertex_selection.hpp"
@@ -101,26 +102,69 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
       if (group >= 0)
         add_pinned(static_cast<int>(s), v, mesh.vertices.row(v).transpose(), sources[v], group);
     }
-    for (std::size_t l = 0; l < shell.loads.size(); ++l) {
-      const Load& load = shell.loads[l];
-      const auto what = fmt::format("load {} of shell '{}'", l + 1, shell.name);
-      std::vector<int> selected = select_vertices(load.selector, mesh, block.topology, what);
-      std::sort(selected.begin(), selected.end());
-      std::vector<double> weight(selected.size(), 1.0);
-      if (load.kind == Load::Kind::Line) weight = line_load_weights(mesh, block.topology, selected);
-      double total = 0.0;
-      for (double w : weight) total += w;
-      if (total <= 0.0)
-        throw InputError(
-            fmt::format("{}: {} is a line load but selects no boundary edge (both ends "
-                        "of an edge must be selected)",
-                        scene_.source.string(), what));
-      for (std::size_t k = 0; k < selected.size(); ++k)
-        external_force_.segment<3>(3 * (block.first_vertex + selected[k])) +=
-            load.total_force * weight[k] / total;
-    }
+    add_loads(static_cast<int>(s), mesh);
+    add_probes(static_cast<int>(s), mesh, sources);
   }
   add_colliders(scene_collider_meshes());
+  set_load_time(0.0);
+}
+
+void ShellSystem::add_loads(int shell_index, const TriMesh& mesh) {
+  const Shell& shell = scene_.shells[shell_index];
+  const ShellBlock& block = shells_[shell_index];
+  for (std::size_t l = 0; l < shell.loads.size(); ++l) {
+    const Load& load = shell.loads[l];
+    const auto what = fmt::format("load {} of shell '{}'", l + 1, shell.name);
+    std::vector<int> selected = select_vertices(load.selector, mesh, block.topology, what);
+    std::sort(selected.begin(), selected.end());
+    std::vector<double> weight(selected.size(), 1.0);
+    if (load.kind == Load::Kind::Line) weight = line_load_weights(mesh, block.topology, selected);
+    double total = 0.0;
+    for (double w : weight) total += w;
+    if (total <= 0.0)
+      throw InputError(
+          fmt::format("{}: {} is a line load but selects no boundary edge (both ends "
+                      "of an edge must be selected)",
+                      scene_.source.string(), what));
+    for (std::size_t k = 0; k < selected.size(); ++k)
+      loads_.segment<3>(3 * (block.first_vertex + selected[k])) +=
+          load.total_force * weight[k] / total;
+  }
+}
+
+void ShellSystem::add_probes(int shell_index, const TriMesh& mesh,
+                             const std::vector<PinSources>& sources) {
+  const Shell& shell = scene_.shells[shell_index];
+  const ShellBlock& block = shells_[shell_index];
+  for (const Probe& probe : shell.probes) {
+    SystemProbe resolved{probe.name, probe.kind, {}};
+    if (probe.kind == ProbeKind::displacement) {
+      const auto what = fmt::format("probe '{}' of shell '{}'", probe.name, shell.name);
+      for (int v : select_vertices(probe.selector, mesh, block.topology, what))
+        resolved.indices.push_back(block.first_vertex + v);
+    } else {
+      const auto pin = std::find_if(shell.pins.begin(), shell.pins.end(),
+                                    [&](const PinnedSet& p) { return p.name == probe.pin; });
+      if (pin == shell.pins.end())
+        throw InputError(fmt::format("{}: probe '{}' of shell '{}' names no pin of the shell ('{}')",
+                                     scene_.source.string(), probe.name, shell.name, probe.pin));
+      const int set = static_cast<int>(pin - shell.pins.begin());
+      for (int v = 0; v < mesh.vertex_count(); ++v)
+        for (int c = 0; c < 3; ++c)
+          if (sources[v][c] == set) resolved.indices.push_back(3 * (block.first_vertex + v) + c);
+      // Every component of the set's vertices may come from earlier sets.
+      if (resolved.indices.empty())
+        throw InputError(fmt::format(
+            "{}: probe '{}' of shell '{}' records the reaction of pin '{}', but earlier pins "
+            "fix every component of that pin's vertices; probe the pin that fixes them",
+            scene_.source.string(), probe.name, shell.name, probe.pin));
+    }
+    probes_.push_back(std::move(resolved));
+  }
+}
+
+void ShellSystem::set_load_time(double time) {
+  external_force_ = weight_ + load_scale_at(scene_.load_scale, time) * loads_;
 }
 
 ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
@@ -162,6 +206,7 @@ ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& 
     throw std::invalid_argument(fmt::format("ShellSystem: {} level meshes for {} colliders",
                                             colliders.size(), scene_.colliders.size()));
   add_colliders(colliders.empty() ? scene_collider_meshes() : colliders);
+  set_load_time(0.0);
 }
 
 std::vector<TriMesh> ShellSystem::scene_collider_meshes() const {
@@ -187,7 +232,8 @@ void ShellSystem::add_colliders(const std::vector<TriMesh>& meshes) {
     rest_.triangles.bottomRows(block.triangle_count) = mesh.triangles.array() + block.first_vertex;
     const Eigen::Index dofs = 3 * rest_.vertex_count();
     dof_masses_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
-    external_force_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
+    weight_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
+    loads_.conservativeResizeLike(Eigen::VectorXd::Zero(dofs));
     for (int v = 0; v < block.vertex_count; ++v)
       pinned_.push_back({block.first_vertex + v,
                          mesh.vertices.row(v).transpose(),
@@ -219,7 +265,8 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
   rest_.vertices.resize(vertices, 3);
   rest_.triangles.resize(triangles, 3);
   dof_masses_ = Eigen::VectorXd::Zero(3 * vertices);
-  external_force_ = Eigen::VectorXd::Zero(3 * vertices);
+  weight_ = Eigen::VectorXd::Zero(3 * vertices);
+  loads_ = Eigen::VectorXd::Zero(3 * vertices);
   for (std::size_t s = 0; s < shells_.size(); ++s) {
     const Shell& shell = scene_.shells[s];
     const ShellBlock& block = shells_[s];
@@ -234,7 +281,7 @@ void ShellSystem::add_shells(const std::vector<TriMesh>& meshes) {
     for (int v = 0; v < block.vertex_count; ++v) {
       const int g = block.first_vertex + v;
       dof_masses_.segment<3>(3 * g).setConstant(mass[v]);
-      external_force_.segment<3>(3 * g) += mass[v] * scene_.gravity;
+      weight_.segment<3>(3 * g) += mass[v] * scene_.gravity;
     }
   }
 }

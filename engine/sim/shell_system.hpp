@@ -58,6 +58,15 @@ struct LevelShellMesh {
   std::vector<PinSources> shared_pins;
 };
 
+/// A probe of the scene resolved on the system's vertices (engine/sim/probes.hpp reads it).
+struct SystemProbe {
+  std::string name;
+  ProbeKind kind = ProbeKind::displacement;
+  /// ProbeKind::displacement: the selected vertices; ProbeKind::reaction: the DOFs (3·vertex +
+  /// component) the probed set fixes, each fixed DOF belonging to the first set that fixes it.
+  std::vector<int> indices;
+};
+
 class ShellSystem {
  public:
   /// Builds every shell's mesh, energies, masses, pins and loads. Throws InputError for
@@ -69,7 +78,8 @@ class ShellSystem {
   /// on the finest mesh only, so they are left out (the progressive solver applies the finest
   /// external force through the prolongation). `colliders` are the colliders' rest meshes at
   /// this level, one per scene collider in order (each vertex follows its collider's motions
-  /// from its own rest position); empty: the scene's own collider meshes.
+  /// from its own rest position); empty: the scene's own collider meshes. Probes are selected
+  /// on the finest mesh too and are left out alike.
   /// @throws std::invalid_argument when the meshes or pin groups do not fit the scene.
   ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
               const std::vector<TriMesh>& colliders = {});
@@ -93,8 +103,14 @@ class ShellSystem {
   [[nodiscard]] const std::vector<ShellBending>& bendings() const { return bendings_; }
   /// Lumped mass per DOF (3n).
   [[nodiscard]] const Eigen::VectorXd& dof_masses() const { return dof_masses_; }
-  /// Constant external force per DOF (3n): gravity and loads.
+  /// External force per DOF (3n) at the load time last set (set_load_time; 0 until then):
+  /// gravity plus the loads scaled by the scene's load scale.
   [[nodiscard]] const Eigen::VectorXd& external_force() const { return external_force_; }
+  /// Sets the time the external force is of: the loads scaled by the scene's load scale at
+  /// `time` (scene.hpp, LoadScale); gravity stays as it is.
+  void set_load_time(double time);
+  /// The scene's probes on this system's vertices, in scene order (none below the finest).
+  [[nodiscard]] const std::vector<SystemProbe>& probes() const { return probes_; }
   /// The vertices with at least one fixed component (shell pins, then every collider vertex).
   [[nodiscard]] const std::vector<PinnedVertex>& pinned() const { return pinned_; }
   /// Per DOF (3n), whether a pin fixes it.
@@ -124,6 +140,11 @@ class ShellSystem {
   /// pin group `group` with the components `sources` fixes.
   void add_pinned(int shell, int v, const Eigen::Vector3d& rest, const PinSources& sources,
                   int group);
+  /// Appends shell `shell`'s loads to loads_ (selected on `mesh`, its finest mesh).
+  void add_loads(int shell, const TriMesh& mesh);
+  /// Appends shell `shell`'s probes, selected on `mesh`; `sources` is, per vertex, the set
+  /// that fixes each component.
+  void add_probes(int shell, const TriMesh& mesh, const std::vector<PinSources>& sources);
 
   Scene scene_;
   TriMesh rest_;
@@ -132,8 +153,11 @@ class ShellSystem {
   std::vector<MembraneEnergy> membranes_;
   std::vector<ShellBending> bendings_;
   Eigen::VectorXd dof_masses_;
-  Eigen::VectorXd external_force_;
+  Eigen::VectorXd weight_;      ///< gravity on the lumped masses, per DOF
+  Eigen::VectorXd loads_;       ///< the loads at scale 1, per DOF
+  Eigen::VectorXd external_force_;  ///< weight_ + s · loads_ at the load time last set
   std::vector<PinnedVertex> pinned_;
+  std::vector<SystemProbe> probes_;
   std::vector<std::vector<PinSources>> shared_pins_;  ///< per shell, LevelShellMesh::shared_pins
 };
 

@@ -101,8 +101,70 @@ constexpr const char* kVersionSixColumns =
     "ALTER TABLE levels DROP COLUMN outputs; ALTER TABLE sweeps DROP COLUMN refine; "
     "ALTER TABLE sweeps DROP COLUMN refine_pending; ";
 
-/// Drops what version 7 added (the hierarchy cache uses), leaving what a version-6 store holds.
-constexpr const char* kVersionSevenTables = "DROP TABLE hierarchy_cache_uses; ";
+/// Drops what version 8 added (frames and probe readings), leaving what a version-7 store holds.
+constexpr const char* kVersionEightTables = "DROP TABLE frames; DROP TABLE probe_readings; ";
+
+/// Drops what versions 8 and 7 added (the hierarchy cache uses), leaving what a version-6 store
+/// holds.
+const std::string kVersionSevenTables =
+    std::string(kVersionEightTables) + "DROP TABLE hierarchy_cache_uses; ";
+
+TEST(JobStoreSchema, AVersionSevenStoreGainsFramesWithProbeReadingsKeepingItsLevels) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    store.add_sweep("s", "s.toml", test::thickness_jobs(0, 2));
+    const auto claim = store.claim_next(test::worker("w"), 30);
+    LevelRecord level;
+    level.checkpoint_path = "/runs/snapshot_0.h5";
+    level.checkpoint_checksum = "fnv1a64:0000000000000001";
+    store.record_level(claim->lease, level);
+  }
+  {
+    SqliteConnection raw(path, 1000);
+    raw.execute(std::string(kVersionEightTables) + "DELETE FROM schema_version WHERE version > 7");
+    ASSERT_EQ(schema_version(raw), 7);
+    ASSERT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sqlite_schema WHERE name IN ('frames', "
+                                  "'probe_readings')"),
+              0);
+  }
+  JobStore upgraded(path);
+  const auto claim = upgraded.claim_next(test::worker("w2"), 30);
+  ASSERT_TRUE(claim);
+  const std::string first = upgraded.results(JobSelection::all()).front().job.id;
+  // The level stored before the upgrade is still there, without frames.
+  const auto before = upgraded.results(JobSelection::job(first));
+  ASSERT_EQ(before.front().levels.size(), 1u);
+  EXPECT_TRUE(before.front().levels.front().frames.empty());
+
+  // Two records of one level: the second repeats frame 2 (a settling step recorded again) and
+  // adds frame 3; frames come back in order, frame 2 as last written.
+  LevelRecord level;
+  level.frames = {{1, 0.5, {{"tip", "displacement", {0, 0, -0.25}}}},
+                  {2, 0.75, {{"tip", "displacement", {0, 0, -0.5}}}}};
+  upgraded.record_level(claim->lease, level);
+  level.frames = {{3, 1.0, {{"clamp", "reaction", {0, 0, -4}}, {"tip", "displacement", {0, 0, -1}}}},
+                  {2, 0.75, {{"tip", "displacement", {0, 0, -0.625}}}}};
+  upgraded.record_level(claim->lease, level);
+  const std::vector<FrameReadings> expected{
+      {1, 0.5, {{"tip", "displacement", {0, 0, -0.25}}}},
+      {2, 0.75, {{"tip", "displacement", {0, 0, -0.625}}}},
+      {3, 1.0, {{"clamp", "reaction", {0, 0, -4}}, {"tip", "displacement", {0, 0, -1}}}}};
+  const auto results = upgraded.results(JobSelection::job(claim->job.id));
+  ASSERT_EQ(results.front().levels.size(), 1u);
+  EXPECT_EQ(results.front().levels.front().frames, expected);
+
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  // An unknown kind is refused by the table itself.
+  EXPECT_THROW(raw.execute("INSERT INTO probe_readings VALUES ('" + claim->job.id +
+                           "', 0, 1, 'p', 'speed', 0, 0, 0)"),
+               DatabaseError);
+  // A fenced write: a stale attempt writes no frames.
+  Lease stale = claim->lease;
+  stale.attempt -= 1;
+  EXPECT_THROW(upgraded.record_level(stale, level), LeaseLostError);
+}
 
 TEST(JobStoreSchema, AVersionSixStoreGainsHierarchyCacheUsesKeepingItsJobs) {
   const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
@@ -112,7 +174,7 @@ TEST(JobStoreSchema, AVersionSixStoreGainsHierarchyCacheUsesKeepingItsJobs) {
   }
   {
     SqliteConnection raw(path, 1000);
-    raw.execute(std::string(kVersionSevenTables) + "DELETE FROM schema_version WHERE version > 6");
+    raw.execute(kVersionSevenTables + "DELETE FROM schema_version WHERE version > 6");
     ASSERT_EQ(schema_version(raw), 6);
     ASSERT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sqlite_schema WHERE name = "
                                   "'hierarchy_cache_uses'"),
@@ -150,7 +212,7 @@ TEST(JobStoreSchema, AVersionFiveStoreIsRebuiltKeepingJobsLevelsAndLinks) {
   }
   {
     SqliteConnection raw(path, 1000);
-    raw.execute(std::string(kVersionSevenTables) + kVersionSixColumns +
+    raw.execute(kVersionSevenTables + kVersionSixColumns +
                 "DELETE FROM schema_version WHERE version > 5");
     ASSERT_EQ(schema_version(raw), 5);
   }
@@ -179,7 +241,7 @@ TEST(JobStoreSchema, AVersionThreeStoreIsUpgradedKeepingItsJobs) {
     // Back to what a store written by a version-3 psq holds.
     SqliteConnection raw(path, 1000);
     raw.execute(
-        std::string(kVersionSevenTables) + kVersionSixColumns +
+        kVersionSevenTables + kVersionSixColumns +
         "ALTER TABLE jobs DROP COLUMN progress_attempt; ALTER TABLE jobs DROP COLUMN stalls; "
         "ALTER TABLE levels DROP COLUMN refinement; DELETE FROM schema_version WHERE version > 3");
     ASSERT_EQ(schema_version(raw), 3);

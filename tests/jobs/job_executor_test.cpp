@@ -74,6 +74,8 @@ class ScriptedSolver final : public jobs::LevelSolver {
     record.must_converge = level_ + 1 == levels_;  // coarser levels are previews
     record.iterations = iterations_;
     record.elastic_energy = x_.squaredNorm();  // any function of the result will do
+    // A load ramped by a quarter per frame, and vertex 0's position as a probe.
+    record.readings = {frame, 0.25 * frame, {{"p", "displacement", {x_[0], x_[1], x_[2]}}}};
     return record;
   }
   void refine(const RefinementPhase&) override {
@@ -182,6 +184,25 @@ const Checkpoint& reference() {
   return checkpoint;
 }
 
+/// The frames an uninterrupted run of the job records.
+const std::vector<db::LevelRecord>& reference_levels() {
+  static const std::vector<db::LevelRecord> levels = [] {
+    Workspace fresh;
+    EXPECT_EQ(fresh.run(), jobs::RunOutcome::done);
+    return fresh.result().levels;
+  }();
+  return levels;
+}
+
+/// Every level of `r` has every frame once, each as the uninterrupted run recorded it.
+void expect_frames_as_reference(const db::JobResult& r) {
+  ASSERT_EQ(r.levels.size(), reference_levels().size());
+  for (std::size_t l = 0; l < r.levels.size(); ++l) {
+    ASSERT_EQ(r.levels[l].frames.size(), static_cast<std::size_t>(kFrames)) << "level " << l;
+    EXPECT_EQ(r.levels[l].frames, reference_levels()[l].frames) << "level " << l;
+  }
+}
+
 void expect_same_as_reference(const Checkpoint& c) {
   EXPECT_EQ(c.positions, reference().positions);
   EXPECT_EQ(c.solver.scalars, reference().solver.scalars);
@@ -240,6 +261,16 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
   const PartMeshes parts = read_part_meshes(run_dir().part_meshes(1));
   ASSERT_EQ(parts.parts.size(), 1u);
   EXPECT_EQ(parts.parts[0].positions, c.positions);
+  // Each frame's readings, in order, across the level's snapshots and its final record; the last
+  // frame's probe is where the level ended.
+  for (const db::LevelRecord& level : r.levels) {
+    ASSERT_EQ(level.frames.size(), static_cast<std::size_t>(kFrames));
+    for (int k = 0; k < kFrames; ++k) {
+      EXPECT_EQ(level.frames[k].frame, k + 1);
+      EXPECT_EQ(level.frames[k].load_scale, 0.25 * (k + 1));
+    }
+  }
+  EXPECT_EQ(r.levels[1].frames.back().probes.at(0).value[0], c.positions(0, 0));
 }
 
 TEST_F(Executor, StopWritesASnapshotReleasesAndResumesToTheSameResult) {
@@ -265,6 +296,8 @@ TEST_F(Executor, StopWritesASnapshotReleasesAndResumesToTheSameResult) {
       << log;
   EXPECT_EQ(result().job.state, db::JobState::done);
   expect_same_as_reference(final_checkpoint());
+  // The frames the first attempt recorded and those the resumed one solved, each once.
+  expect_frames_as_reference(result());
 }
 
 TEST_F(Executor, ADamagedSnapshotFallsBackToThePreviousOne) {

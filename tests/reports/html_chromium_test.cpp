@@ -113,11 +113,11 @@ TEST(HtmlReportInChromium, ShowsEveryPlotAndPictureAndScreenshotsAsARealPage) {
   const auto dump = chromium(
       dir / "profile", {"--dump-dom", "--virtual-time-budget=10000", "file://" + probe.string()});
   ASSERT_EQ(dump.exit_code, 0) << dump.errors;
-  // The same counts as the page's source (report_writer_test): 10 plots, 5 pictures of 8-,
-  // 32- and 128-triangle levels (job 1), 8 (job 2, level 0) and 8 plus a 2-triangle collider
-  // (job 3).
-  EXPECT_EQ(dom_number(dump.output, "images"), 10);
-  EXPECT_EQ(dom_number(dump.output, "decoded"), 10);
+  // The same counts as the page's source (report_writer_test): 12 plots (2 of them job 1's
+  // probes), 5 pictures of 8-, 32- and 128-triangle levels (job 1), 8 (job 2, level 0) and 8
+  // plus a 2-triangle collider (job 3).
+  EXPECT_EQ(dom_number(dump.output, "images"), 12);
+  EXPECT_EQ(dom_number(dump.output, "decoded"), 12);
   EXPECT_EQ(dom_number(dump.output, "shapes"), 5);
   EXPECT_EQ(dom_number(dump.output, "polygons"),
             8 + 32 + 128 + 8 + 8 + test::kColliderTriangles);

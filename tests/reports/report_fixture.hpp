@@ -42,6 +42,8 @@ struct FixtureLevel {
   double lift = 0;              ///< δ_l
   CheckpointCase checkpoint = CheckpointCase::absolute_path;
   std::string error;
+  /// Frames with their load scale and probe readings, as the executor records them.
+  std::vector<db::FrameReadings> frames = {};
 };
 
 struct FixtureJob {
@@ -101,6 +103,10 @@ inline std::vector<FixtureJob> fixture_jobs() {
        CheckpointCase::workspace_relative,
        ""},
   };
+  // The finest level's load ramp: a tip probe and a clamp's reaction at s = 1/2, 1.
+  jobs[0].levels.back().frames = {
+      {1, 0.5, {{"clamp", "reaction", {0, 0, -2}}, {"tip", "displacement", {0, 0, -0.01}}}},
+      {2, 1.0, {{"clamp", "reaction", {0, 0, -4}}, {"tip", "displacement", {0, 0, -0.02}}}}};
   // A diverged iteration in the middle: stored as null, skipped when drawn.
   jobs[0].levels[2].residuals.insert(jobs[0].levels[2].residuals.begin() + 2, NAN);
   jobs[1] = {"00000000000000b2", 2e-3, 1e6, db::JobState::done, "", 0.1, std::nullopt, {}, false};
@@ -282,6 +288,7 @@ inline std::filesystem::path make_report_fixture(const std::filesystem::path& di
       record.residuals = level.residuals;
       record.timings = level.timings;
       record.static_residuals = {{1, fixture_static_residual(l)}};
+      record.frames = level.frames;
       record.error = level.error;
       if (level.status == db::LevelStatus::done) {
         std::uint64_t checksum = 0x1234;

@@ -49,6 +49,37 @@ TEST(ConvergencePlots, OneCurvePerSolveTheSolvesOfAFrameShareColourAndLegendEntr
   EXPECT_FALSE(convergence_plots(job).front().integer_x);  // 40 tics would crowd the axis
 }
 
+TEST(ProbePlots, OnePlotPerProbeOfTheFinestLevelAgainstTheLoadScale) {
+  JobReport job = finished_job(3, {}, 0.0);
+  job.levels.resize(2);
+  // A coarse level's frames are not the answer: only the finest level's are plotted.
+  job.levels[0].frames = {{1, 0.5, {{"coarse_only", "displacement", {1, 1, 1}}}}};
+  job.levels[1].frames = {
+      {1, 0.5, {{"tip", "displacement", {0.3, 1e-13, -0.4}}, {"clamp", "reaction", {0, 0, -2}}}},
+      {2, 1.0, {{"tip", "displacement", {0.6, 0, -0.8}}, {"clamp", "reaction", {0, 0, -4}}}}};
+  const std::vector<PlotSpec> plots = probe_plots(job);
+  ASSERT_EQ(plots.size(), 2u);
+  EXPECT_EQ(plots[0].title, "job #3: probe 'tip' against the load scale");
+  EXPECT_EQ(plots[0].x_label, "load scale");
+  EXPECT_EQ(plots[0].y_label, "mean displacement (m)");
+  // x and z, the magnitude; y is at round-off (1e-13) and left out.
+  ASSERT_EQ(plots[0].series.size(), 3u);
+  EXPECT_EQ(plots[0].series[0].title, "x");
+  EXPECT_EQ(plots[0].series[1].title, "z");
+  EXPECT_EQ(plots[0].series[2].title, "magnitude");
+  const std::vector<std::pair<double, double>> magnitude{{0.5, 0.5}, {1.0, 1.0}};
+  ASSERT_EQ(plots[0].series[2].points.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(plots[0].series[2].points[k].first, magnitude[k].first);
+    EXPECT_NEAR(plots[0].series[2].points[k].second, magnitude[k].second, 1e-15);
+  }
+  EXPECT_EQ(plots[1].y_label, "reaction (N)");
+  EXPECT_EQ(plots[1].series[0].points.back(), std::make_pair(1.0, -4.0));
+
+  job.levels[1].frames.clear();
+  EXPECT_TRUE(probe_plots(job).empty());
+}
+
 TEST(NewtonSolves, ASettlingStepStartsANewSolveWhereTheCountRepeatsAndAFrameWhereItChanges) {
   // As psq work records them: frame 1 is a step of 2 iterations ended by a record without a
   // step, then a settling step continuing the frame's count; frame 2 is already at rest.

@@ -191,6 +191,14 @@ TEST_F(ReportWriter, JsonHoldsEveryJobWithItsLevelsAndResidualHistories) {
   EXPECT_NEAR(json["jobs"][0]["levels"][1]["error_to_finest"].get<double>(), 0.01 / std::sqrt(2.04),
               1e-15);
   EXPECT_EQ(json["jobs"][1]["problems"].size(), 1u);
+  // Job 1's finest frames, from the store: probes in name order.
+  const nlohmann::json& frames = json["jobs"][0]["levels"][2]["frames"];
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[1]["frame"], 2);
+  EXPECT_EQ(frames[1]["load_scale"], 1.0);
+  EXPECT_EQ(frames[1]["probes"][0],
+            nlohmann::json({{"name", "clamp"}, {"kind", "reaction"}, {"value", {0, 0, -4}}}));
+  EXPECT_TRUE(json["jobs"][0]["levels"][0]["frames"].empty());
 }
 
 TEST_F(ReportWriter, MarkdownSummaryHasTheTablesAndTheProblems) {
@@ -211,10 +219,14 @@ TEST_F(ReportWriter, HtmlHasEveryPlotAndPictureAndNoNetworkReference) {
   // Plots: time per level, error against run time, the 3 outputs against the thickness (the
   // swept parameter with the most values among finished jobs), and one convergence plot per
   // level with a readable checkpoint of a finished job: 3 (job 1) + 1 (job 2, level 0) + 1
-  // (job 3). Pictures: those 5 levels, each job's with one colour bar; job 3's collider is
-  // drawn from its part-meshes file.
-  EXPECT_EQ(count(html, "<img "), 1u + 1u + 3u + 5u);
-  EXPECT_EQ(count(html, "src=\"data:image/svg+xml;base64,"), 10u);
+  // (job 3), and one per probe of job 1's finest level (2). Pictures: those 5 levels, each job's
+  // with one colour bar; job 3's collider is drawn from its part-meshes file.
+  EXPECT_EQ(count(html, "<img "), 1u + 1u + 3u + 5u + 2u);
+  EXPECT_EQ(count(html, "src=\"data:image/svg+xml;base64,"), 12u);
+  EXPECT_NE(html.find("alt=\"job #1: probe &#39;tip&#39; against the load scale\""),
+            std::string::npos);
+  EXPECT_NE(html.find("alt=\"job #1: probe &#39;clamp&#39; against the load scale\""),
+            std::string::npos);
   EXPECT_EQ(count(html, "<svg class=\"shape\""), 5u);
   EXPECT_EQ(count(html, "<svg class=\"colour-bar\""), 3u);
   EXPECT_EQ(count(html, "class=\"collider\""), static_cast<std::size_t>(test::kColliderTriangles));

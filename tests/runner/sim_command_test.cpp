@@ -55,6 +55,43 @@ TEST(SimCommand, WritesEveryFrameAndASummary) {
   EXPECT_EQ(summary["frames"][2]["contact"]["barrier_stiffness"].get<double>(), 0.0);
 }
 
+TEST(SimCommand, SummaryHasEachFramesLoadScaleAndProbes) {
+  const auto dir = test::fresh_temp_dir("sim_probes");
+  // The sag scene with a 1 mN downward load on its free edge, ramped over 3 frames of 0.05 s,
+  // and probes: the loaded edge's mean displacement and what the pinned edge carries.
+  const auto scene = test::write_file(
+      dir / "sag.toml",
+      small_scene(3) +
+          "[[shell.load]]\nbox = { min = [0.09, -0.11, -0.01], max = [0.11, 0.11, 0.01] }\n"
+          "force = [0, 0, -1e-3]\n"
+          "[[shell.probe]]\nname = \"free_edge\"\n"
+          "box = { min = [0.09, -0.11, -0.01], max = [0.11, 0.11, 0.01] }\n"
+          "[[shell.probe]]\nname = \"held\"\npin = \"edge\"\n"
+          "[load_scale]\nend = 0.15\n");
+  const auto result = test::run_psq({"sim", scene.string(), "--out", (dir / "out").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.errors;
+  std::ifstream in(dir / "out" / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  ASSERT_EQ(summary["frames"].size(), 3u);
+  const double weight = 200 * 1e-3 * 0.2 * 0.2 * 9.81;  // ρ h A g [N]
+  for (int k = 0; k < 3; ++k) {
+    const auto& frame = summary["frames"][k];
+    SCOPED_TRACE(k + 1);
+    const double scale = (k + 1) / 3.0;
+    EXPECT_NEAR(frame["load_scale"].get<double>(), scale, 1e-12);
+    ASSERT_EQ(frame["probes"].size(), 2u);
+    EXPECT_EQ(frame["probes"][0]["name"], "free_edge");
+    EXPECT_EQ(frame["probes"][0]["kind"], "displacement");
+    EXPECT_LT(frame["probes"][0]["value"][2].get<double>(), 0.0);  // the edge sags
+    const auto& held = frame["probes"][1];
+    EXPECT_EQ(held["kind"], "reaction");
+    // The pinned edge carries the weight and the ramped load, both along −z.
+    const double carried = weight + scale * 1e-3;
+    EXPECT_NEAR(held["value"][2].get<double>(), -carried, 1e-3 * carried);
+    EXPECT_NEAR(held["magnitude"].get<double>(), carried, 1e-3 * carried);
+  }
+}
+
 TEST(SimCommand, ContactScenesReportTheirContactAndFrictionPerFrame) {
   const auto dir = test::fresh_temp_dir("sim_contact");
   const auto result =
