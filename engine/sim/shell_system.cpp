@@ -8,10 +8,12 @@
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
+#include "engine/mesh/triangle_shape.hpp"
 #include "engine/scene/rigid_motion.hpp"
 #include "engine/scene/shell_mesh.hpp"
 #include "engine/scene/vertex_selection.hpp"
 #include "engine/sim/lumped_mass.hpp"
+#include "engine/sim/solver_tolerance.hpp"
 
 namespace psq {
 namespace {
@@ -78,7 +80,9 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
   std::vector<TriMesh> meshes;
   for (const Shell& shell : scene_.shells) {
     TriMesh mesh = build_shell_mesh(shell.mesh);
-    validate_mesh(mesh, fmt::format("{}: shell '{}'", scene_.source.string(), shell.name));
+    const std::string source = fmt::format("{}: shell '{}'", scene_.source.string(), shell.name);
+    validate_mesh(mesh, source);
+    check_shell_triangle_shapes(mesh, source);
     meshes.push_back(std::move(mesh));
   }
   add_shells(meshes);
@@ -121,6 +125,7 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
     }
   }
   add_colliders(scene_collider_meshes());
+  check_convergence_resolution(scene_, bounding_box_diagonal(rest_.vertices));
 }
 
 ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
