@@ -294,8 +294,9 @@ TEST(StressSuite, EveryCaseEndsCleanOrFailsNamingWhatToChange) {
     const test::ProcessResult added = test::run_psq({"sweep", "add", sweep.string(), "--db", db});
     ASSERT_EQ(added.exit_code, 0) << added.errors;
   }
-  for (const auto& [id, job] : jobs)
+  for (const auto& [id, job] : jobs) {
     if (!job.runs) ASSERT_EQ(test::run_psq({"cancel", id, "--db", db}).exit_code, 0) << id;
+  }
   const test::ProcessResult worked = test::run_psq({"work", "--workers", "2", "--db", db});
   // Some jobs fail by design, which `psq work` reports with exit code 5.
   EXPECT_TRUE(worked.exit_code == 0 || worked.exit_code == 5) << worked.errors;
@@ -309,7 +310,9 @@ TEST(StressSuite, EveryCaseEndsCleanOrFailsNamingWhatToChange) {
     SCOPED_TRACE(job.sweep + ": " + job.description);
     if (job.expected->expect == Expect::done) {
       EXPECT_EQ(result.job.state, db::JobState::done) << result.job.error;
-      if (result.job.state == db::JobState::done) EXPECT_EQ(problems_of_done(result, job), "");
+      if (result.job.state == db::JobState::done) {
+        EXPECT_EQ(problems_of_done(result, job), "");
+      }
     } else if (job.expected->expect == Expect::fails) {
       EXPECT_EQ(result.job.state, db::JobState::failed);
       for (const std::string& fragment : job.expected->message)
