@@ -295,7 +295,9 @@ TEST(StressSuite, EveryCaseEndsCleanOrFailsNamingWhatToChange) {
     ASSERT_EQ(added.exit_code, 0) << added.errors;
   }
   for (const auto& [id, job] : jobs) {
-    if (!job.runs) ASSERT_EQ(test::run_psq({"cancel", id, "--db", db}).exit_code, 0) << id;
+    if (!job.runs) {
+      ASSERT_EQ(test::run_psq({"cancel", id, "--db", db}).exit_code, 0) << id;
+    }
   }
   const test::ProcessResult worked = test::run_psq({"work", "--workers", "2", "--db", db});
   // Some jobs fail by design, which `psq work` reports with exit code 5.
