@@ -58,7 +58,6 @@ const std::map<std::string, std::string> kCoarse = {
     {"stress-units", "shell.sheet.mesh.edge_length=0.025"},
     {"stress-triangles", ""},
     {"stress-sliver", ""},
-    {"stress-sub-floor", ""},
 };
 
 const std::vector<StressCase>& stress_cases() {
@@ -170,11 +169,6 @@ const std::vector<StressCase>& stress_cases() {
        {},
        Expect::fails,
        {"shell 'sheet': triangle", "is a sliver", "below 1e-05", "Remesh the shell"},
-       true},
-      {"stress-sub-floor",
-       {},
-       Expect::fails,
-       {"sub_floor_sheet.obj:", "is degenerate", "move its vertices apart"},
        true},
   };
   return cases;

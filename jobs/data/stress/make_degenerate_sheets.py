@@ -11,8 +11,6 @@ cap_sheet.obj        a structured 10 x 10 grid with a row of caps: above the row
                      degrees) of quality 1e-4 or 1e-3.
 sliver_sheet.obj     the needle sheet with its needle column 2e-8 m wide: quality 1e-6, below the
                      floor of shell triangles (engine/mesh/triangle_shape.hpp), refused.
-sub_floor_sheet.obj  the cap sheet with one cap 2e-16 m high: area 2.5e-17 x diagonal^2, below
-                     the mesh reader's floor of 1e-14, refused.
 
 Rerun from this directory to regenerate: python3 make_degenerate_sheets.py
 """
@@ -76,5 +74,3 @@ cap_sheet("cap_sheet.obj", [2e-6] * 5 + [2e-5] * 5,
           "0.2 m sheet with a row of caps of quality 1e-4 and 1e-3 (docs/stress.md)")
 needle_sheet("sliver_sheet.obj", [2e-8],
              "0.2 m sheet with a column of needle cells of quality 1e-6 (docs/stress.md)")
-cap_sheet("sub_floor_sheet.obj", [2e-5] * 9 + [2e-16],
-          "0.2 m sheet with one cap 2e-16 m high, below the degenerate-area floor (docs/stress.md)")
