@@ -1,6 +1,7 @@
 #include "engine/sim/contact_term.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -114,9 +115,9 @@ bool ContactTerm::update_stiffness(const Eigen::VectorXd& x, bool steps_cut_by_c
   const double min_distance = potential_.min_distance(x);
   const BarrierBand& band = potential_.parameters().band;
   const double gap_scale = kStiffeningGapFraction * band.activation_distance / bbox_diagonal_;
-  const BarrierStiffness updated = update_barrier_stiffness(
-      stiffness_, previous_min_distance_, min_distance, bbox_diagonal_, band, gap_scale,
-      steps_cut_by_ccd);
+  const BarrierStiffness updated =
+      update_barrier_stiffness(stiffness_, previous_min_distance_, min_distance, bbox_diagonal_,
+                               band, gap_scale, steps_cut_by_ccd);
   previous_min_distance_ = min_distance;
   if (fixed_stiffness_ || updated.value == stiffness_.value) return false;
   stiffness_ = updated;
@@ -140,12 +141,17 @@ constexpr const char* kPreviousMinDistanceName = "contact.previous_min_distance"
 void ContactTerm::save_state(std::map<std::string, double>& state) const {
   state[kStiffnessName] = stiffness_.value;
   state[kMaxStiffnessName] = stiffness_.max;
-  state[kPreviousMinDistanceName] = previous_min_distance_;
+  // Infinite while no pair is within reach; checkpoints hold finite scalars only, so that
+  // distance is written as its absence (docs/stress.md: a contact-free frame's snapshot was
+  // refused).
+  if (std::isfinite(previous_min_distance_))
+    state[kPreviousMinDistanceName] = previous_min_distance_;
 }
 
 void ContactTerm::load_state(const std::map<std::string, double>& state) {
   load_named(state, kStiffnessName, stiffness_.value);
   load_named(state, kMaxStiffnessName, stiffness_.max);
+  previous_min_distance_ = std::numeric_limits<double>::infinity();
   load_named(state, kPreviousMinDistanceName, previous_min_distance_);
   potential_.set_stiffness(stiffness_.value);
 }

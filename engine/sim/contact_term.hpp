@@ -58,9 +58,11 @@ class ContactTerm : public PotentialTerm {
   /// push pairs apart to a given gap rather than balance the forces at x.
   void scale_stiffness(double factor);
 
-  /// Adds κ, its upper bound and the last smallest distance to `state` ("contact.*").
+  /// Adds κ, its upper bound and the last smallest distance to `state` ("contact.*"); the
+  /// distance only while some pair was within reach (it is infinite otherwise).
   void save_state(std::map<std::string, double>& state) const;
-  /// Takes back what save_state wrote; names missing from `state` keep their values.
+  /// Takes back what save_state wrote; a missing κ or bound keeps its value, a missing distance
+  /// is infinite (no pair was within reach).
   void load_state(const std::map<std::string, double>& state);
 
   double value(const Eigen::VectorXd& x) override { return potential_.value(x); }

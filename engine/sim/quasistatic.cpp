@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "engine/core/error.hpp"
+#include "engine/sim/solver_tolerance.hpp"
 
 namespace psq {
 namespace {
@@ -29,7 +30,7 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
   settings_.max_iterations = scene.solver.max_iterations;
   settings_.project_on_demand = scene.solver.project_on_demand;
   settings_.tolerance =
-      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(system_.rest_mesh().vertices));
+      solver_tolerance(scene, bounding_box_diagonal(system_.rest_mesh().vertices));
 }
 
 void QuasistaticSimulation::settle(FrameRecord& record, const NewtonSettings& settings,

@@ -8,11 +8,13 @@
 
 #include "engine/core/error.hpp"
 #include "engine/mesh/mesh_io.hpp"
+#include "engine/mesh/triangle_shape.hpp"
 #include "engine/scene/load_scale.hpp"
 #include "engine/scene/rigid_motion.hpp"
 #include "engine/scene/shell_mesh.hpp"
 #include "engine/scene/vertex_selection.hpp"
 #include "engine/sim/lumped_mass.hpp"
+#include "engine/sim/solver_tolerance.hpp"
 
 namespace psq {
 namespace {
@@ -79,7 +81,9 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
   std::vector<TriMesh> meshes;
   for (const Shell& shell : scene_.shells) {
     TriMesh mesh = build_shell_mesh(shell.mesh);
-    validate_mesh(mesh, fmt::format("{}: shell '{}'", scene_.source.string(), shell.name));
+    const std::string source = fmt::format("{}: shell '{}'", scene_.source.string(), shell.name);
+    validate_mesh(mesh, source);
+    check_shell_triangle_shapes(mesh, source);
     meshes.push_back(std::move(mesh));
   }
   add_shells(meshes);
@@ -107,6 +111,7 @@ ShellSystem::ShellSystem(const Scene& scene) : scene_(scene) {
   }
   add_colliders(scene_collider_meshes());
   set_load_time(0.0);
+  check_convergence_resolution(scene_, bounding_box_diagonal(rest_.vertices));
 }
 
 void ShellSystem::add_loads(int shell_index, const TriMesh& mesh) {

@@ -70,7 +70,9 @@ struct SystemProbe {
 class ShellSystem {
  public:
   /// Builds every shell's mesh, energies, masses, pins and loads. Throws InputError for
-  /// selections that select nothing and for meshes that fail validation.
+  /// selections that select nothing, for meshes that fail validation, for shells with slivers
+  /// (check_shell_triangle_shapes) and for a time step the tolerance cannot judge convergence
+  /// at (check_convergence_resolution).
   explicit ShellSystem(const Scene& scene);
   /// The system of one hierarchy level: the scene's shells (same order, materials and
   /// motions) with the given rest meshes; each pinned vertex follows its set's motions from its
