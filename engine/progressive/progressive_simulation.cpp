@@ -14,6 +14,7 @@
 #include "engine/core/error.hpp"
 #include "engine/progressive/refinement_statistics.hpp"
 #include "engine/sim/contact_term.hpp"
+#include "engine/sim/solver_tolerance.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 
 namespace psq {
@@ -129,8 +130,7 @@ void ProgressiveSimulation::initialize() {
     if (k < shells) level_count_ = std::max(level_count_, hierarchies_[k].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
-  finest_tolerance_ =
-      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
+  finest_tolerance_ = solver_tolerance(scene, bounding_box_diagonal(finest_.rest_mesh().vertices));
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
