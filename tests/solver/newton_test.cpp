@@ -679,6 +679,36 @@ TEST(Newton, AReachableToleranceIsNotStagnation) {
   EXPECT_FALSE(result.stagnated);
 }
 
+TEST(Newton, ALinearlyConvergingSolveBelowTheEnergysRoundingIsNotStagnation) {
+  // E = 1e6 + ½|x − 1|² with a Newton matrix 20 times too stiff: full steps converge linearly at
+  // ρ = 0.95, so the step norm halves only every 14 iterations, and E's changes are below its
+  // rounding (1e-12 |E| per iteration) from the start. Steps still shrink by ρ each.
+  class StiffMatrix : public Objective {
+   public:
+    [[nodiscard]] Eigen::Index size() const override { return 6; }
+    double value(const Eigen::VectorXd& x) override {
+      return 1e6 + 0.5 * (x.array() - 1.0).square().sum();
+    }
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+      g = x.array() - 1.0;
+    }
+    void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+      h.diagonal = Eigen::VectorXd::Constant(6, 20.0);
+      h.batches.clear();
+    }
+  } objective;
+  NewtonSettings settings;
+  settings.tolerance = 1e-9;
+  settings.max_iterations = 1000;
+  Eigen::VectorXd x(6);
+  x << 1.001, 0.999, 1.0005, 0.9995, 1.0, 1.0002;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(2, {}), settings);
+  EXPECT_FALSE(result.stagnated);
+  EXPECT_TRUE(result.converged);
+  EXPECT_LT((x.array() - 1.0).abs().maxCoeff(), 20 * settings.tolerance);
+}
+
 TEST(Newton, AnUnjudgedSolveWithNoIterationsLeftDoesNothing) {
   NoisyQuadratic objective(2, 0.0);
   NewtonSettings settings;
