@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -18,6 +19,11 @@ namespace {
 constexpr double kFirstRelativeShift = 1e-8;
 constexpr double kShiftGrowth = 10.0;
 constexpr int kShiftAttempts = 9;
+
+/// Shares β of ∇²E's negative curvature kept in P + β(∇²E − P) when ∇²E itself is indefinite
+/// (project on demand): ½, ¼, ⅛, each a factorization; below ⅛ the blend is nearly P.
+constexpr double kFirstBlend = 0.5;
+constexpr double kLastBlend = 0.125;
 
 /// A full step that lowers E by more than this fraction of the linear prediction −gᵀd (an exact
 /// quadratic model predicts ½) met much less curvature than K promised: the projected Hessian
@@ -219,28 +225,62 @@ Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen
   if (try_unprojected) {
     assemble_hessian(objective, x, dofs, false, record);
     record.projected = false;
-    if (try_newton(0.0, free_gradient, direction, record)) return direction;
+    record.kept_negative_curvature = 1.0;
+    if (try_newton(assembler_.matrix(), 0.0, free_gradient, direction, record)) return direction;
+    exact_ = assembler_.matrix();
   }
   record.projected = true;
+  record.kept_negative_curvature = 0.0;
   assemble_hessian(objective, x, dofs, true, record);
-  if (try_newton(0.0, free_gradient, direction, record)) return direction;
+  if (try_unprojected && try_blends(free_gradient, direction, record)) return direction;
+  if (try_newton(assembler_.matrix(), 0.0, free_gradient, direction, record)) return direction;
 
   record.direction = DirectionKind::shifted_newton;
   double shift = kFirstRelativeShift * diagonal_scale(assembler_.matrix());
   for (int attempt = 0; attempt < kShiftAttempts; ++attempt, shift *= kShiftGrowth) {
     record.shift = shift;
-    if (try_newton(shift, free_gradient, direction, record)) return direction;
+    if (try_newton(assembler_.matrix(), shift, free_gradient, direction, record))
+      return direction;
   }
   record.direction = DirectionKind::gradient;
   record.shift = 0.0;
   return -free_gradient;
 }
 
-bool NewtonSolver::try_newton(double shift, const Eigen::VectorXd& free_gradient,
-                              Eigen::VectorXd& direction, NewtonIteration& record) {
+bool NewtonSolver::try_blends(const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
+                              NewtonIteration& record) {
+  const Eigen::SparseMatrix<double>& projected = assembler_.matrix();
+  const auto same_pattern = [&] {
+    const Eigen::Index nonzeros = projected.nonZeros();
+    const Eigen::Index columns = projected.cols();
+    return exact_.cols() == columns && exact_.nonZeros() == nonzeros &&
+           std::equal(projected.outerIndexPtr(), projected.outerIndexPtr() + columns + 1,
+                      exact_.outerIndexPtr()) &&
+           std::equal(projected.innerIndexPtr(), projected.innerIndexPtr() + nonzeros,
+                      exact_.innerIndexPtr());
+  };
+  if (!projected.isCompressed() || !exact_.isCompressed() || !same_pattern()) return false;
+  blended_ = projected;
+  for (double beta = kFirstBlend; beta >= kLastBlend; beta *= 0.5) {
+    Eigen::Map<Eigen::ArrayXd>(blended_.valuePtr(), blended_.nonZeros()) =
+        Eigen::Map<const Eigen::ArrayXd>(projected.valuePtr(), projected.nonZeros()) +
+        beta * (Eigen::Map<const Eigen::ArrayXd>(exact_.valuePtr(), exact_.nonZeros()) -
+                Eigen::Map<const Eigen::ArrayXd>(projected.valuePtr(), projected.nonZeros()));
+    if (try_newton(blended_, 0.0, free_gradient, direction, record)) {
+      record.projected = false;
+      record.kept_negative_curvature = beta;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool NewtonSolver::try_newton(const Eigen::SparseMatrix<double>& K, double shift,
+                              const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
+                              NewtonIteration& record) {
   try {
     ScopedTimer timer(record.times.factorization);
-    cholmod_.factorize(assembler_.matrix(), shift);
+    cholmod_.factorize(K, shift);
   } catch (const NotPositiveDefiniteError&) {
     return false;
   } catch (const NumericalError& error) {

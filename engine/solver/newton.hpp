@@ -40,7 +40,10 @@ struct NewtonSettings {
   double cut_step = 0.1;  ///< the feasible step below which a step counts as cut
   /// Project-on-demand Newton (Longva et al. 2023, "Pitfalls of Projection"): each direction
   /// is first solved with ∇²E itself (HessianBlocks::project = false), and only when that is
-  /// not positive definite with the element-wise PSD projection. The projection overstates the
+  /// not positive definite with the element-wise PSD projection P, or rather with the first
+  /// of P + β(∇²E − P), β = ½, ¼, ⅛, that is: where a few elements make ∇²E indefinite, P
+  /// would drop the negative curvature of every element, and the blend keeps part of it
+  /// (twist_wrap: 1686 → 1334 iterations, docs/benchmarks.md). The projection overstates the
   /// curvature of compressed membranes, bent hinges and contact pairs, so projected Newton
   /// crawls through flat valleys in short steps (docs/benchmarks.md). Convergence is still
   /// judged on the projected step, so the tolerance means what it means without. Off by
@@ -117,7 +120,12 @@ class NewtonSolver {
                         bool project, NewtonIteration& record);
   /// Factorizes K + shift·I and solves for d; false when that matrix is not positive definite
   /// or d is not a descent direction (gᵀd ≥ 0).
-  bool try_newton(double shift, const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
+  bool try_newton(const Eigen::SparseMatrix<double>& K, double shift,
+                  const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
+                  NewtonIteration& record);
+  /// With ∇²E in exact_ and P in the assembler: d from the first positive definite
+  /// P + β(∇²E − P), β = ½, ¼, ⅛; false when none is (or the patterns differ).
+  bool try_blends(const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
                   NewtonIteration& record);
   /// Backtracking Armijo line search from α = min(1, max_feasible_step); moves x to the
   /// accepted point and returns its energy. Where no α decreases E and the step's predicted
@@ -138,6 +146,8 @@ class NewtonSolver {
   HessianBlocks hessian_;
   SparseAssembler assembler_;
   CholmodSolver cholmod_;
+  Eigen::SparseMatrix<double> exact_;    ///< ∇²E over the free DOFs, kept for the blends
+  Eigen::SparseMatrix<double> blended_;  ///< P + β(∇²E − P)
   Eigen::VectorXd trial_;
   Eigen::VectorXd longer_trial_;
 };

@@ -855,6 +855,29 @@ TEST(Newton, ProjectOnDemandTakesTheExactStepWhereTheProjectionOverstatesCurvatu
   EXPECT_GT(projected.iterations, 3);
 }
 
+TEST(Newton, ProjectOnDemandKeepsHalfTheNegativeCurvatureWhereThatIsPositiveDefinite) {
+  // E = −0.2 u² + u⁴ (u = x − 1), a convex part u² + u⁴ and a concave one −1.2 u²: at
+  // u = 0.05, ∇²E = −0.4 + 12u² = −0.37 is indefinite, P = 2 + 12u² drops the concave part's
+  // −2.4, and P + ½(∇²E − P) = 0.8 + 12u² = 0.83 is positive definite.
+  NewtonSettings settings;
+  settings.tolerance = 1e-10;
+  settings.project_on_demand = true;
+  NewtonSolver solver;
+  ConcavePartObjective objective(1.0, 1.0, -1.2);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(3, 1.05);
+  const NewtonResult result = solver.minimize(objective, x, DofMap(1, {}), settings);
+  ASSERT_TRUE(result.converged);
+  const NewtonIteration& first = result.history.front();
+  EXPECT_FALSE(first.projected);
+  EXPECT_EQ(first.kept_negative_curvature, 0.5);
+  EXPECT_EQ(first.direction, DirectionKind::newton);
+  // The full step of the blend is d = −g/0.83 per coordinate, g = −0.4u + 4u³.
+  const double u = 0.05;
+  const double full_step = (0.4 * u - 4.0 * u * u * u) / (0.8 + 12.0 * u * u);
+  EXPECT_NEAR(first.step_norm, full_step, 1e-12);
+  EXPECT_NEAR((x.array() - 1.0 - std::sqrt(0.1)).abs().maxCoeff(), 0.0, 1e-8);
+}
+
 TEST(Newton, ProjectOnDemandProjectsWhereTheHessianIsIndefinite) {
   // E = −0.75 u² + u⁴ (u = x − 1): ∇²E = −1.5 + 12 u² is negative near u = 0.1, where the
   // solve starts, and positive at the minimum u = √0.375.
