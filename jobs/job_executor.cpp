@@ -141,7 +141,7 @@ class JobRun {
     run_.remove_stale_temporaries();
     try {
       scene_ = job_scene(claim_.job);
-      solver_ = factory_(scene_, claim_.job.depth);
+      solver_ = factory_(scene_, claim_.job.method, hierarchy_depth(claim_.job));
       record_hierarchy_cache_uses();
       resume();
       while (true) {

@@ -16,10 +16,13 @@ namespace psq::jobs {
 
 /// One expanded job of a sweep.
 struct SweepJob {
-  Overrides overrides;        ///< canonical values (see canonical_override)
-  int depth = 1;              ///< hierarchy levels
-  nlohmann::json parameters;  ///< canonical_parameters(scene hash, overrides, depth)
+  Overrides overrides;  ///< canonical values (see canonical_override)
+  int depth = 1;        ///< hierarchy levels (1 for a direct job)
+  db::Method method = db::Method::direct;
+  nlohmann::json parameters;  ///< canonical_parameters(scene hash, overrides, depth, method)
   std::string id;             ///< job_id(parameters)
+  /// The levels the job solves and records: its hierarchy's for a progressive job, else one.
+  int levels() const { return method == db::Method::progressive ? depth : 1; }
 };
 
 /// A sweep file, expanded.

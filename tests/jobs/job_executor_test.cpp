@@ -143,7 +143,7 @@ class Workspace {
     };
     jobs::JobExecutor executor(
         store, dir_ / "psq.db", runs.empty() ? dir_ / "runs" : runs,
-        [this](const Scene&, int depth) {
+        [this](const Scene&, db::Method, int depth) {
           auto solver = std::make_unique<ScriptedSolver>(depth, kFrames, kIterations);
           solver->fail_at_level = fail_at_level;
           solver->fail_at_frame = fail_at_frame;
@@ -448,7 +448,7 @@ TEST(ExecutorScenes, TheResolutionSweepsJobsRunOnMeshesOfTheirEdgeLengths) {
   const std::atomic<bool> stop{false};
   jobs::JobExecutor executor(
       store, dir / "psq.db", dir / "runs",
-      [&](const Scene& scene, int depth) {
+      [&](const Scene& scene, db::Method, int depth) {
         vertices = build_shell_mesh(scene.shells.at(0).mesh).vertex_count();
         return std::make_unique<ScriptedSolver>(depth, 1, 1);
       },
