@@ -9,6 +9,7 @@
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "jobs/job_identity.hpp"
 #include "jobs/run_directory.hpp"
 #include "reports/level_metrics.hpp"
 #include "reports/parameters.hpp"
@@ -232,6 +233,20 @@ HierarchyCacheSummary summarize_cache_uses(const std::vector<db::HierarchyCacheU
       summary.saved_seconds += built->second.first / built->second.second - use.seconds;
   }
   return summary;
+}
+
+std::string method_label(const db::Job& job) {
+  switch (job.method) {
+    case db::Method::direct:
+      return "direct";
+    case db::Method::direct_final:
+      return "direct, settled from the refine frame";
+    case db::Method::progressive:
+      return fmt::format("progressive, {} levels", job.depth);
+    case db::Method::coarse_prolonged:
+      return fmt::format("coarse of {} levels, prolonged", jobs::hierarchy_depth(job));
+  }
+  return "unknown method";
 }
 
 SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {
