@@ -570,9 +570,7 @@ Sweep read_sweep_text(std::string_view text, const fs::path& file) {
 }
 
 std::string describe_parameters(const SweepJob& job) {
-  std::string text = fmt::format("depth={}", job.depth);
-  if (job.parameters.contains(kMethod))
-    text += fmt::format(" method={}", job.parameters.at(kMethod).get<std::string>());
+  std::string text = fmt::format("depth={} method={}", job.depth, db::to_string(job.method));
   for (const auto& [path, value] : job.overrides) text += fmt::format(" {}={}", path, value.dump());
   return text;
 }

@@ -56,8 +56,8 @@ Sweep read_sweep(const std::filesystem::path& file);
 /// callers that hold the text already, such as the fuzz target.
 Sweep read_sweep_text(std::string_view text, const std::filesystem::path& file);
 
-/// "depth=1 shell.cloth.material.thickness=0.0005 ...": a job's parameters on one line, paths
-/// sorted.
+/// "depth=1 method=direct shell.cloth.material.thickness=0.0005 ...": a job's parameters on one
+/// line, paths sorted.
 std::string describe_parameters(const SweepJob& job);
 
 /// The jobs of a sweep as the store takes them.

@@ -26,8 +26,8 @@ namespace {
 constexpr double kLease = 0.4;  // seconds: a killed worker's job is free again soon
 constexpr int kDepth = 2;
 
-/// The cantilever workspace with the sweep "m" of `methods` (a TOML value: a string or a list)
-/// at depth 2, added.
+/// The cantilever workspace with the sweep "m" of `methods` (a TOML list of names) at depth 2,
+/// added.
 struct MethodWorkspace : test::CantileverWorkspace {
   MethodWorkspace(const std::string& name, const std::string& methods)
       : CantileverWorkspace(name) {
@@ -134,7 +134,7 @@ TEST(MethodSweep, EachMethodRunsIsStoredAndTheCoarseAnswerIsProlongedToTheFinest
 class MethodResume : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(MethodResume, AJobKilledInsideItsSolveResumesToTheUninterruptedAnswerBitForBit) {
-  const std::string method = fmt::format("\"{}\"", GetParam());
+  const std::string method = fmt::format("[\"{}\"]", GetParam());
   const MethodWorkspace reference(fmt::format("method_resume_ref_{}", GetParam()), method);
   ASSERT_EQ(reference.run("work"), 0);
   const db::JobResult expected = reference.results().front();
