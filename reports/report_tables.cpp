@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
+#include <iterator>
 
 #include "reports/html_text.hpp"
 #include "reports/parameters.hpp"
@@ -201,10 +203,14 @@ Table refinements_table(const SweepReport& report) {
 }
 
 Table speedup_table(const SweepReport& report) {
+  // The method column names the depth and the method: the other swept parameters give the point.
+  std::vector<std::string> point_parameters;
+  std::copy_if(report.swept_parameters.begin(), report.swept_parameters.end(),
+               std::back_inserter(point_parameters),
+               [](const std::string& name) { return name != "depth" && name != "method"; });
   Table table;
   table.header = {"#", "id"};
-  table.header.insert(table.header.end(), report.swept_parameters.begin(),
-                      report.swept_parameters.end());
+  table.header.insert(table.header.end(), point_parameters.begin(), point_parameters.end());
   for (const char* column :
        {"method", "time (s)", "direct_final time (s)", "speed-up over direct_final",
         "direct time (s)", "speed-up over direct"})
@@ -216,8 +222,7 @@ Table speedup_table(const SweepReport& report) {
                                baseline_of(report, job, db::Method::direct)};
     if (!baselines[0] && !baselines[1]) continue;
     std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
-    for (const std::string& name : report.swept_parameters)
-      row.push_back(parameter_cell(job, name));
+    for (const std::string& name : point_parameters) row.push_back(parameter_cell(job, name));
     row.push_back(method_label(job.job));
     row.push_back(readable_number(job.outputs.total_seconds));
     for (const JobReport* baseline : baselines) {

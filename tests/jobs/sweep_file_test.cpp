@@ -139,6 +139,19 @@ TEST(SweepFile, MethodsAreAnAxisWithDepthAndADirectJobIsListedOnce) {
   EXPECT_EQ(describe_parameters(sweep.jobs[4]), "depth=3 method=coarse_prolonged");
 }
 
+TEST(SweepFile, TheMethodsSweepComparesFourMethodsAtTwoDepthsInSixJobs) {
+  const auto sweep = read_sweep(test::source_dir() / "jobs/sweeps/methods.toml");
+  std::vector<std::string> methods;  // each job's description up to its overrides
+  for (const auto& job : sweep.jobs) {
+    const std::string text = describe_parameters(job);
+    methods.push_back(text.substr(0, text.find(" shell.")));
+  }
+  EXPECT_EQ(methods, (std::vector<std::string>{
+                         "depth=1 method=direct", "depth=1 method=direct_final",
+                         "depth=2 method=progressive", "depth=2 method=coarse_prolonged",
+                         "depth=3 method=progressive", "depth=3 method=coarse_prolonged"}));
+}
+
 TEST(SweepFile, ATopLevelMethodAppliesToEveryJob) {
   const auto sweep = read_sweep(write_sweep(
       sweep_dir(), "method = \"coarse_prolonged\"\ndepth = 3\n[grid]\n\"" + kH + "\" = [1e-3, 2e-3]\n"));

@@ -2,11 +2,12 @@
 
 #include "reports/report_tables.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
-
 #include <algorithm>
+
+#include "reports/parameters.hpp"
 
 namespace psq::reports {
 namespace {
@@ -68,12 +69,14 @@ JobReport timed_job(int number, db::Method method, int depth, double thickness, 
   job.job.parameters = {{"depth", depth},
                         {"overrides", {{"shell.s.material.thickness", thickness}}},
                         {"scene", "fnv1a64:0000000000000001"}};
+  job.parameters = flatten_parameters(job.job.parameters);
   job.outputs.total_seconds = seconds;
   return job;
 }
 
 TEST(ReportTables, SpeedUpsCompareEachHierarchyJobWithBothDirectBaselinesOfItsDesignPoint) {
   SweepReport report;
+  report.swept_parameters = {"depth", "method", "overrides.shell.s.material.thickness"};
   report.jobs = {timed_job(1, db::Method::direct, 1, 1e-3, 10.0),
                  timed_job(2, db::Method::direct_final, 1, 1e-3, 6.0),
                  timed_job(3, db::Method::progressive, 3, 1e-3, 2.0),
@@ -85,12 +88,16 @@ TEST(ReportTables, SpeedUpsCompareEachHierarchyJobWithBothDirectBaselinesOfItsDe
                  timed_job(7, db::Method::progressive, 2, 3e-3, 1.0)};
   const Table table = speedup_table(report);
   ASSERT_EQ(table.rows.size(), 3u);
+  // The point's parameters, and the method (with its depth) once.
+  EXPECT_EQ(std::count(table.header.begin(), table.header.end(), "method"), 1);
+  EXPECT_EQ(std::count(table.header.begin(), table.header.end(), "depth"), 0);
   const auto cell = [&](std::size_t row, const std::string& column) {
     const auto found = std::find(table.header.begin(), table.header.end(), column);
     EXPECT_NE(found, table.header.end()) << column;
     return table.rows[row][static_cast<std::size_t>(found - table.header.begin())];
   };
   EXPECT_EQ(cell(0, "#"), "3");
+  EXPECT_EQ(cell(0, "overrides.shell.s.material.thickness"), "0.001");
   EXPECT_EQ(cell(0, "method"), "progressive, 3 levels");
   EXPECT_EQ(cell(0, "speed-up over direct_final"), "3");
   EXPECT_EQ(cell(0, "speed-up over direct"), "5");
