@@ -286,8 +286,13 @@ class JobRun {
       if (frame.must_converge && !frame.converged)
         throw NotConverged(fmt::format(
             "level {} frame {} did not converge within solver.max_iterations = {} (‖Δx‖∞/Δt = "
-            "{:.3e} at the end)",
-            frame.level, frame.frame, scene_.solver.max_iterations, frame.step_norm));
+            "{:.3e} at the end){}",
+            frame.level, frame.frame, scene_.solver.max_iterations, frame.step_norm,
+            scene_.solver.project_on_demand
+                ? ""
+                : "; raise it, or try [solver] hessian = \"project_on_demand\" (docs/"
+                  "scene-format.md), whose steps converge faster where the projected Hessian "
+                  "overstates the curvature"));
       if (!solver_->level_done() && snapshot_due())
         snapshot(LevelProgress::frame_done, solver_->frame(), 0);
     }

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -96,6 +97,16 @@ std::string verdict(const NewtonResult& newton) {
   return "NOT converged";
 }
 
+/// A direct frame's settling, for its progress line: the static residual only where the settling
+/// reached an equilibrium (NaN otherwise, which would read like a numerical failure).
+std::string settling_text(const FrameRecord& record) {
+  if (record.settle_steps == 0) return "";
+  if (std::isnan(record.static_residual))
+    return fmt::format(", {} settling steps, no equilibrium reached", record.settle_steps);
+  return fmt::format(", {} settling steps, static residual {:.3e}", record.settle_steps,
+                     record.static_residual);
+}
+
 /// The summary fields of every run; the progressive one adds its levels.
 nlohmann::json run_summary(const Scene& scene, const TriMesh& rest, double tolerance,
                            int level_count, bool all_converged, const nlohmann::json& frames) {
@@ -160,9 +171,7 @@ int run_direct(const Scene& scene, const SimOptions& sim_options) {
         "{}  frame {}/{}: {} iterations, {}, ‖Δx‖∞/Δt {:.3e}{}, {:.3f} s\n", terminal ? "\r" : "",
         record.frame, sim.frame_count(), record.newton.iterations,
         verdict(record.newton), record.newton.step_norm,
-        record.settle_steps > 0 ? fmt::format(", {} settling steps, static residual {:.3e}",
-                                              record.settle_steps, record.static_residual)
-                                : "",
+        settling_text(record),
         record.newton.wall_seconds);
   }
   return finish(out,

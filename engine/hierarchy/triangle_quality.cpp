@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 
+#include "engine/mesh/triangle_shape.hpp"
+
 namespace psq {
 
 namespace {
@@ -23,11 +25,9 @@ double minimum_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
 }
 
 double aspect_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const double area = 0.5 * (b - a).cross(c - a).norm();
-  if (area == 0) return std::numeric_limits<double>::infinity();
-  const double longest2 =
-      std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
-  return longest2 * std::sqrt(3.0) / (4 * area);
+  const double quality = triangle_shape_quality(a, b, c);
+  if (!(quality > 0)) return std::numeric_limits<double>::infinity();  // degenerate, or one point
+  return std::sqrt(3.0) / (2 * quality);
 }
 
 MeshQuality mesh_quality(const TriMesh& mesh) {

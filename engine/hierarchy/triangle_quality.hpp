@@ -11,7 +11,8 @@ namespace psq {
 double minimum_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
 /// Longest edge over shortest altitude, scaled so that an equilateral triangle has 1:
-/// ℓ_max² √3 / (4 A). A smallest angle θ bounds it by √3 cot θ. +∞ when degenerate.
+/// ℓ_max² √3 / (4 A) = (√3/2) / triangle_shape_quality. A smallest angle θ bounds it by
+/// √3 cot θ. +∞ when degenerate.
 double aspect_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
 /// Worst shape over a mesh.

@@ -14,6 +14,7 @@
 #include "engine/core/error.hpp"
 #include "engine/progressive/refinement_statistics.hpp"
 #include "engine/sim/contact_term.hpp"
+#include "engine/sim/solver_tolerance.hpp"
 #include "engine/sim/strain_limit_term.hpp"
 
 namespace psq {
@@ -40,8 +41,8 @@ constexpr const char* kUnconvergedStep = "progressive.unconverged_step";
 constexpr int kMaxStalledSettleSteps = 8;
 constexpr double kSettleProgress = 0.99;
 
-/// The Newton budget of a fixed-step scene's first step at the finest level, in the scene's
-/// max_iterations. That step starts from the initializer, not from the previous frame, and
+/// The Newton budget of a fixed-step scene's first step at a level entered by refinement, in the
+/// scene's max_iterations. That step starts from the initializer, not from the previous frame, and
 /// corrects the whole difference between the prolonged coarse answer and the fine one, which an
 /// equilibrium scene's settling spreads over several steps (docs/benchmarks.md, twist_wrap).
 constexpr int kEntryStepBudgets = 5;
@@ -129,8 +130,7 @@ void ProgressiveSimulation::initialize() {
     if (k < shells) level_count_ = std::max(level_count_, hierarchies_[k].level_count());
   }
   refine_frame_ = settings_.schedule.refine_frame.value_or(scene.time.frames);
-  finest_tolerance_ =
-      scene.solver.tolerance.value_or(1e-4 * bounding_box_diagonal(finest_.rest_mesh().vertices));
+  finest_tolerance_ = solver_tolerance(scene, bounding_box_diagonal(finest_.rest_mesh().vertices));
   preview_tolerance_ =
       settings_.schedule.preview_tolerance.value_or(kPreviewToleranceFactor * finest_tolerance_);
   build_prolongations();
@@ -329,7 +329,16 @@ ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   // The refine frame's one step of Δt at a level entered by refinement (a fixed-step scene).
   const bool entry_step = out.settling && !frames_are_equilibria();
   NewtonSettings settings = stepper_->settings();
-  if (entry_step && finest_level()) settings.max_iterations *= kEntryStepBudgets;
+  // Below the finest level of a fixed-step scene the refine frame's step is the state the next
+  // level is prolonged from, and no settling converges it: capped at preview_iterations it would
+  // hand the refinement a state far from the level's answer, which the finer level then has to
+  // correct in steps its CCD cuts short. Solved to the level's tolerance, it costs coarse
+  // iterations only.
+  if (!frames_are_equilibria() && !finest_level() && frame == refine_frame_) {
+    settings.max_iterations = finest_.scene().solver.max_iterations;
+    settings.judge_final_iterate = true;
+  }
+  if (entry_step) settings.max_iterations *= kEntryStepBudgets;
   out.frame = stepper_->step(
       previous_, x_, frame, time_step, iterations_done, settings,
       [&](const NewtonIteration& it) {

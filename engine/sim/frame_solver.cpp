@@ -175,6 +175,9 @@ NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs
   // Numbered within the whole solve, across the chunks.
   const NewtonSolver::Progress numbered = offset_progress(progress, done);
   NewtonSettings chunk = settings;
+  // One watcher across the chunks, which are shorter than its window; a new one whenever a
+  // stiffness update changes the objective, whose energies are then not comparable.
+  RoundoffStagnation stagnation;
   // Only the barrier's κ answers creeping, and only where the CCD alone bounds the steps: with
   // strain limits the bound may be the limit's, which no κ relaxes, and stiffening the barrier
   // there only changes the path.
@@ -188,18 +191,19 @@ NewtonResult FrameSolver::solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs
     // assembles and factorizes there anyway: judging it here too would do that twice.
     chunk.judge_final_iterate =
         done + chunk.max_iterations < settings.max_iterations ? false : settings.judge_final_iterate;
-    NewtonResult part = newton_.minimize(potential_, x, dofs, chunk, numbered);
+    NewtonResult part = newton_.minimize(potential_, x, dofs, chunk, numbered, &stagnation);
     done += part.iterations;
     const bool creeping = steps_cut_by_ccd(part);
     append_solve(total, std::move(part));
     if (total.converged || total.stagnated || done >= settings.max_iterations) return total;
-    update_stiffnesses(x, creeping);
+    if (update_stiffnesses(x, creeping)) stagnation = RoundoffStagnation{};
   }
 }
 
-void FrameSolver::update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd) {
-  if (contact_) contact_->update_stiffness(x, steps_cut_by_ccd);
-  if (strain_limit_) strain_limit_->update_stiffness(x);
+bool FrameSolver::update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd) {
+  const bool contact_changed = contact_ && contact_->update_stiffness(x, steps_cut_by_ccd);
+  const bool limit_changed = strain_limit_ && strain_limit_->update_stiffness(x);
+  return contact_changed || limit_changed;
 }
 
 void FrameSolver::solve_held(Eigen::VectorXd& x, const Eigen::VectorXd& previous,

@@ -123,8 +123,9 @@ class FrameSolver {
   NewtonResult solve_in_chunks(Eigen::VectorXd& x, const DofMap& dofs,
                                const NewtonSettings& settings,
                                const NewtonSolver::Progress& progress);
-  /// IPC's κ update and Codim-IPC's κ_s update at x, for the terms the scene has.
-  void update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd);
+  /// IPC's κ update and Codim-IPC's κ_s update at x, for the terms the scene has; true when
+  /// either changed (the objective is then another one).
+  bool update_stiffnesses(const Eigen::VectorXd& x, bool steps_cut_by_ccd);
 
   const ShellSystem& system_;
   IncrementalPotential& potential_;

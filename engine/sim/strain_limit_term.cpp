@@ -81,16 +81,20 @@ void StrainLimitTerm::load_state(const std::map<std::string, double>& state) {
   }
 }
 
-void StrainLimitTerm::update_stiffness(const Eigen::VectorXd& x) {
+bool StrainLimitTerm::update_stiffness(const Eigen::VectorXd& x) {
+  bool changed = false;
   for (std::size_t k = 0; k < energies_.size(); ++k) {
     Adaptation& adaptation = adaptations_[k];
     StrainLimitEnergy& energy = energies_[k];
     const double slack = energy.min_slack(x);
-    energy.set_stiffness(update_strain_limit_stiffness(energy.stiffness(),
-                                                       adaptation.previous_min_slack, slack,
-                                                       energy.band(), adaptation.max_stiffness));
+    const double stiffness = update_strain_limit_stiffness(
+        energy.stiffness(), adaptation.previous_min_slack, slack, energy.band(),
+        adaptation.max_stiffness);
+    changed = changed || stiffness != energy.stiffness();
+    energy.set_stiffness(stiffness);
     adaptation.previous_min_slack = slack;
   }
+  return changed;
 }
 
 double StrainLimitTerm::value(const Eigen::VectorXd& x) {

@@ -29,8 +29,9 @@ class StrainLimitTerm : public PotentialTerm {
   void require_feasible(const Eigen::VectorXd& x, const std::string& state) const;
 
   /// Codim-IPC's κ_s update of each limited shell at the iterate x
-  /// (update_strain_limit_stiffness, against that shell's slack at the previous call).
-  void update_stiffness(const Eigen::VectorXd& x);
+  /// (update_strain_limit_stiffness, against that shell's slack at the previous call); true when
+  /// any κ_s changed.
+  bool update_stiffness(const Eigen::VectorXd& x);
 
   /// Adds each limited shell's κ_s and last slack to `state` ("strain_limit.<shell>.*").
   void save_state(std::map<std::string, double>& state) const;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -30,45 +31,13 @@ constexpr double kMaxExtrapolation = 64.0;
 /// converging solve off (a static cantilever at tolerance 1e-9 m stalled at 100 iterations).
 constexpr double kExtrapolationFloor = 1e-9;
 
+/// A failed line search whose step was predicted to lower E by less than this many times E's
+/// measured rounding has stagnated at round-off: descent that small is lost in the rounding.
+constexpr double kResolvableDecrease = 100.0;
+
 /// Energy changes smaller than this fraction of |E| are below the rounding of E itself, so
 /// the Armijo test does not reject a step for them (it would stall a converging solve).
 constexpr double kEnergyRoundoff = 1e-12;
-
-/// Watches a solve for stagnation at round-off (NewtonResult::stagnated): the step norm stops
-/// falling while the energy changes only by its rounding. A slow solve that still lowers E
-/// (backtracking through a fold, contact) is not stagnating, however long its step norms wander.
-/// E is judged per window of iterations, not since the best step norm: one real drop of E (a
-/// late snap) must not hide the rounding-level changes that follow it.
-class RoundoffStagnation {
- public:
-  /// Iterations without the step norm halving, and without E falling beyond its rounding,
-  /// before a solve has stagnated.
-  static constexpr int kWindow = 10;
-
-  /// Takes an iteration's step norm and its starting energy; true once stagnated.
-  bool stagnated(double step_norm, double energy) {
-    if (step_norm < 0.5 * best_step_norm_) {
-      best_step_norm_ = step_norm;
-      start_window(energy);
-      return false;
-    }
-    if (++iterations_in_window_ < kWindow) return false;
-    if (energy_at_window_start_ - energy <= kWindow * kEnergyRoundoff * std::abs(energy))
-      return true;
-    start_window(energy);
-    return false;
-  }
-
- private:
-  void start_window(double energy) {
-    energy_at_window_start_ = energy;
-    iterations_in_window_ = 0;
-  }
-
-  double best_step_norm_ = std::numeric_limits<double>::infinity();
-  double energy_at_window_start_ = 0.0;
-  int iterations_in_window_ = 0;
-};
 
 void check_settings(const NewtonSettings& s) {
   const auto require = [](bool ok, const char* name, double value, const char* range) {
@@ -117,8 +86,27 @@ double diagonal_scale(const Eigen::SparseMatrix<double>& upper) {
 
 }  // namespace
 
+bool RoundoffStagnation::stagnated(double step_norm, double energy) {
+  if (step_norm < kProgress * best_step_norm_) {
+    best_step_norm_ = step_norm;
+    start_window(energy);
+    return false;
+  }
+  if (++iterations_in_window_ < kWindow) return false;
+  if (energy_at_window_start_ - energy <= kWindow * kEnergyRoundoff * std::abs(energy))
+    return true;
+  start_window(energy);
+  return false;
+}
+
+void RoundoffStagnation::start_window(double energy) {
+  energy_at_window_start_ = energy;
+  iterations_in_window_ = 0;
+}
+
 NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, const DofMap& dofs,
-                                    const NewtonSettings& settings, const Progress& progress) {
+                                    const NewtonSettings& settings, const Progress& progress,
+                                    RoundoffStagnation* stagnation) {
   const auto start = std::chrono::steady_clock::now();
   check_settings(settings);
   if (objective.size() != x.size() || dofs.full_size() != x.size())
@@ -147,7 +135,8 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
 
   Eigen::VectorXd gradient;
   Eigen::VectorXd free_gradient;
-  RoundoffStagnation stagnation;
+  RoundoffStagnation own_stagnation;
+  RoundoffStagnation& watcher = stagnation != nullptr ? *stagnation : own_stagnation;
   int consecutive_cut_steps = 0;
   for (int k = 0;; ++k) {
     record.iteration = k;
@@ -174,10 +163,12 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     // A gradient fallback step says nothing about the distance to the minimum.
     result.converged =
         record.direction != DirectionKind::gradient && record.step_norm < settings.tolerance;
-    result.stagnated = !result.converged && stagnation.stagnated(record.step_norm, energy);
-    if (!result.converged && !result.stagnated && k < settings.max_iterations)
+    result.stagnated = !result.converged && watcher.stagnated(record.step_norm, energy);
+    if (!result.converged && !result.stagnated && k < settings.max_iterations) {
       energy = line_search(objective, x, direction, energy, free_gradient.dot(free_direction),
                            settings, record);
+      result.stagnated = record.below_energy_rounding;
+    }
 
     result.history.push_back(record);
     result.times += record.times;
@@ -270,10 +261,14 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
   record.feasible_step = std::min(1.0, feasible);
 
   const double slack = kEnergyRoundoff * std::abs(energy);
+  // E at the smallest α whose point still differs from x: the model's change is negligible
+  // there, so what E changed by is its own rounding.
+  std::optional<double> smallest_move_energy;
   for (double alpha = record.feasible_step; alpha >= settings.min_step;
        alpha *= settings.backtracking) {
     trial_ = x + alpha * direction;
     const double trial_energy = objective.value(trial_);
+    if (std::isfinite(trial_energy) && trial_ != x) smallest_move_energy = trial_energy;
     ++record.line_search_trials;
     const double bound = energy + settings.armijo * alpha * slope + slack;
     if (std::isfinite(trial_energy) && trial_energy <= bound) {
@@ -287,6 +282,19 @@ double NewtonSolver::line_search(Objective& objective, Eigen::VectorXd& x,
       x.swap(trial_);
       return accepted;
     }
+  }
+  // A sum of large cancelling terms can round far above ε|E| (a plate 1e6 times stiffer than
+  // the cloth on it). A step whose whole predicted decrease is below E's rounding cannot be
+  // resolved, and neither can one whose trials, every one, rounded back to x; a step predicted
+  // to gain far more that still finds no decrease is a failure.
+  const bool resolvable =
+      record.line_search_trials == 0 ||
+      (smallest_move_energy.has_value() &&
+       !(-slope * record.feasible_step <
+         kResolvableDecrease * std::abs(*smallest_move_energy - energy)));
+  if (!resolvable) {
+    record.below_energy_rounding = true;
+    return energy;
   }
   throw NumericalError(fmt::format(
       "line search failed at iteration {}, ‖g‖ = {:.6e} (first trial step {:.3e}, {} trials, "

@@ -5,6 +5,7 @@
 // stencils.
 
 #include <functional>
+#include <limits>
 
 #include "engine/solver/cholmod_solver.hpp"
 #include "engine/solver/dof_map.hpp"
@@ -48,6 +49,38 @@ struct NewtonSettings {
   bool project_on_demand = false;
 };
 
+/// Watches a solve for stagnation at round-off (NewtonResult::stagnated): the step norm stops
+/// falling while the energy changes only by its rounding. A slow solve that still lowers E
+/// (backtracking through a fold, contact) is not stagnating, however long its step norms wander.
+/// E is judged per window of iterations, not since the best step norm: one real drop of E (a
+/// late snap) must not hide the rounding-level changes that follow it.
+/// Nor is a solve stagnating whose step norm still falls steadily: a Newton matrix stiffer than
+/// ∇²E (element-wise PSD projection where the assembled ∇²E is positive) converges linearly, and
+/// near the minimum its energy changes drop below E's rounding long before its steps reach
+/// round-off (the drape at Δt = 1e-3 s: step norms falling 5 % per iteration, docs/stress.md).
+/// A caller that splits one solve into several minimize calls (FrameSolver's chunks between κ
+/// updates, shorter than the window) passes one watcher to all of them.
+class RoundoffStagnation {
+ public:
+  /// Iterations without the step norm falling to kProgress of its best, and without E falling
+  /// beyond its rounding, before a solve has stagnated.
+  static constexpr int kWindow = 10;
+  /// A step norm below this fraction of the best so far is progress: a linear rate ρ counts as
+  /// converging when ρ^k < kProgress for some k ≤ kWindow (ρ up to about 0.99), where a step norm
+  /// at round-off wanders without setting such lows for long.
+  static constexpr double kProgress = 0.9;
+
+  /// Takes an iteration's step norm and its starting energy; true once stagnated.
+  bool stagnated(double step_norm, double energy);
+
+ private:
+  void start_window(double energy);
+
+  double best_step_norm_ = std::numeric_limits<double>::infinity();
+  double energy_at_window_start_ = 0.0;
+  int iterations_in_window_ = 0;
+};
+
 /// Minimizes an Objective over the free DOFs of a DofMap. Each iteration: gradient, projected
 /// Hessian blocks, sparse assembly, Cholesky, direction d = −K⁻¹g (with a diagonal shift, then
 /// the negative gradient, as fallbacks when K is not positive definite or d is not a descent
@@ -66,8 +99,11 @@ class NewtonSolver {
   ///   when the gradient or Hessian becomes non-finite, or when the line search cannot
   ///   decrease E above min_step.
   /// @throws InputError when a setting is out of range (naming it).
+  /// `stagnation`: the watcher to continue (one solve split over several calls); a fresh one
+  /// when null.
   NewtonResult minimize(Objective& objective, Eigen::VectorXd& x, const DofMap& dofs,
-                        const NewtonSettings& settings, const Progress& progress = {});
+                        const NewtonSettings& settings, const Progress& progress = {},
+                        RoundoffStagnation* stagnation = nullptr);
 
  private:
   /// Hessian, assembly, factorization and solve, with the fallbacks; returns d over the free
@@ -84,7 +120,9 @@ class NewtonSolver {
   bool try_newton(double shift, const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
                   NewtonIteration& record);
   /// Backtracking Armijo line search from α = min(1, max_feasible_step); moves x to the
-  /// accepted point and returns its energy.
+  /// accepted point and returns its energy. Where no α decreases E and the step's predicted
+  /// decrease is below the rounding of E itself (measured at the smallest α tried), x stays and
+  /// record.below_energy_rounding is set: the solve has stagnated at round-off.
   double line_search(Objective& objective, Eigen::VectorXd& x, const Eigen::VectorXd& direction,
                      double energy, double slope, const NewtonSettings& settings,
                      NewtonIteration& record);

@@ -50,6 +50,9 @@ struct NewtonIteration {
   /// d came from the element-wise PSD-projected Hessian (false: from ∇²E itself, which was
   /// positive definite; NewtonSettings::project_on_demand).
   bool projected = true;
+  /// The line search found no decrease of E, and the step's predicted decrease was below the
+  /// rounding of E: no step was taken, and the solve stagnated at round-off.
+  bool below_energy_rounding = false;
   PhaseTimes times;
 };
 
@@ -58,9 +61,10 @@ struct NewtonIteration {
 struct NewtonResult {
   bool converged = false;
   /// Stopped before converging because the solve stagnated at round-off: for
-  /// kStagnationWindow iterations the step norm did not halve while E decreased by no more than
-  /// its rounding. The tolerance is then finer than double precision resolves for this problem,
-  /// and step_norm is the accuracy reached.
+  /// RoundoffStagnation::kWindow iterations the step norm made no progress while E decreased by
+  /// no more than its rounding, or a line search found no decrease below E's rounding
+  /// (NewtonIteration::below_energy_rounding). The tolerance is then finer than double precision
+  /// resolves for this problem, and step_norm is the accuracy reached.
   bool stagnated = false;
   /// Steps taken: history.size() − 1, or history.size() when the final iterate was not judged
   /// (NewtonSettings::judge_final_iterate): then the last record is the last step's.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -311,6 +312,31 @@ TEST(ProgressiveContact, AFixedStepSceneIsSteppedAtItsRefineFrameNotSettled) {
   slide /= patch_vertices;
   const double coulomb_step = test::coulomb_step(scene, scene.contact.friction);
   EXPECT_NEAR(slide, coulomb_step, 0.05 * coulomb_step);
+}
+
+TEST(ProgressiveContact, AFixedStepScenesCoarseLevelSolvesItsRefineFrameToTheTolerance) {
+  // Nothing settles a fixed-step scene's coarse level, so the refine frame's step is the state
+  // the refinement prolongs: it is solved to the level's tolerance with the scene's budget, while
+  // the preview steps before it stop at preview_iterations.
+  const Scene scene = scene_from(kTwist, "twist");
+  ProgressiveSettings settings = ProgressiveSettings::from_scene(scene);
+  settings.schedule.levels = 2;
+  ProgressiveSimulation sim(scene, settings);
+  std::vector<ProgressiveStep> coarse_steps;
+  while (!sim.level_done()) coarse_steps.push_back(sim.step());
+  ASSERT_EQ(coarse_steps.size(), static_cast<std::size_t>(scene.time.frames));
+  const ProgressiveStep& refine_step = coarse_steps.back();
+  EXPECT_EQ(refine_step.frame.frame, scene.time.frames);
+  EXPECT_TRUE(refine_step.frame.newton.converged);
+  EXPECT_LT(refine_step.frame.newton.step_norm, sim.tolerance());
+  EXPECT_GT(refine_step.frame.newton.iterations, settings.schedule.preview_iterations);
+  const auto capped = std::count_if(coarse_steps.begin(), coarse_steps.end() - 1,
+                                    [&](const ProgressiveStep& step) {
+                                      return !step.frame.newton.converged &&
+                                             step.frame.newton.iterations ==
+                                                 settings.schedule.preview_iterations;
+                                    });
+  EXPECT_GT(capped, 0);
 }
 
 TEST(ProgressiveContact, CollidersAreDecimatedAndEndAtTheirScriptedPlaces) {

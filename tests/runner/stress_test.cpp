@@ -147,11 +147,15 @@ const std::vector<StressCase>& stress_cases() {
        Expect::done,
        {},
        true},
-      // On the fine cloth Newton reports stagnation at round-off at 6.4e-7 m, far above the
-      // positions' round-off (docs/stress.md, open findings).
+      // On the fine cloth Newton converges linearly at full steps (docs/stress.md, finding 2).
       {"stress-time-step",
-       {"time.step=0.001", "shell.cloth.mesh.edge_length=0.02"},
-       Expect::open,
+       {"time.step=0.001", "solver.max_iterations=200", "shell.cloth.mesh.edge_length=0.02"},
+       Expect::fails,
+       {"did not converge within solver.max_iterations = 200"},
+       false},
+      {"stress-time-step",
+       {"time.step=0.001", "solver.max_iterations=2000", "shell.cloth.mesh.edge_length=0.02"},
+       Expect::done,
        {},
        false},
       {"stress-time-step", {"time.step=10.0"}, Expect::done, {}, true},

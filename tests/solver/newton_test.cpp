@@ -679,6 +679,97 @@ TEST(Newton, AReachableToleranceIsNotStagnation) {
   EXPECT_FALSE(result.stagnated);
 }
 
+TEST(Newton, ALinearlyConvergingSolveBelowTheEnergysRoundingIsNotStagnation) {
+  // E = 1e6 + ½|x − 1|² with a Newton matrix 20 times too stiff: full steps converge linearly at
+  // ρ = 0.95, so the step norm halves only every 14 iterations, and E's changes are below its
+  // rounding (1e-12 |E| per iteration) from the start. Steps still shrink by ρ each.
+  class StiffMatrix : public Objective {
+   public:
+    [[nodiscard]] Eigen::Index size() const override { return 6; }
+    double value(const Eigen::VectorXd& x) override {
+      return 1e6 + 0.5 * (x.array() - 1.0).square().sum();
+    }
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override {
+      g = x.array() - 1.0;
+    }
+    void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+      h.diagonal = Eigen::VectorXd::Constant(6, 20.0);
+      h.batches.clear();
+    }
+  } objective;
+  NewtonSettings settings;
+  settings.tolerance = 1e-9;
+  settings.max_iterations = 1000;
+  Eigen::VectorXd x(6);
+  x << 1.001, 0.999, 1.0005, 0.9995, 1.0, 1.0002;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(2, {}), settings);
+  EXPECT_FALSE(result.stagnated);
+  EXPECT_TRUE(result.converged);
+  EXPECT_LT((x.array() - 1.0).abs().maxCoeff(), 20 * settings.tolerance);
+}
+
+TEST(Newton, ALineSearchLostInTheEnergysRoundingIsStagnationNotFailure) {
+  // E = ½|x − 1|² that rounds 1e-5 higher anywhere but at the start (as a sum of large
+  // cancelling terms can): no α decreases E, and the step's predicted decrease (3e-6) is below
+  // that rounding, so the solve has stagnated at round-off; it is no line-search failure.
+  class RoundedHighAway : public Objective {
+   public:
+    explicit RoundedHighAway(Eigen::VectorXd start) : start_(std::move(start)) {}
+    [[nodiscard]] Eigen::Index size() const override { return 3; }
+    double value(const Eigen::VectorXd& x) override {
+      return 0.5 * (x.array() - 1.0).square().sum() + (x == start_ ? 0.0 : 1e-5);
+    }
+    void gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g) override { g = x.array() - 1.0; }
+    void hessian(const Eigen::VectorXd&, HessianBlocks& h) override {
+      h.diagonal = Eigen::VectorXd::Ones(3);
+      h.batches.clear();
+    }
+
+   private:
+    Eigen::VectorXd start_;
+  };
+  const Eigen::VectorXd start = Eigen::VectorXd::Constant(3, 1.0 + 1e-3);
+  RoundedHighAway objective(start);
+  NewtonSettings settings;
+  settings.tolerance = 1e-12;
+  Eigen::VectorXd x = start;
+  NewtonSolver solver;
+  const NewtonResult result = solver.minimize(objective, x, DofMap(1, {}), settings);
+  EXPECT_TRUE(result.stagnated);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.iterations, 0);
+  ASSERT_FALSE(result.history.empty());
+  EXPECT_TRUE(result.history.back().below_energy_rounding);
+  EXPECT_EQ(x, start) << "no step is taken";
+  EXPECT_NEAR(result.step_norm, 1e-3, 1e-12);
+}
+
+TEST(Newton, OneWatcherFindsStagnationAcrossSolvesShorterThanItsWindow) {
+  // The noisy quadratic stagnates after a few iterations; solved in chunks of 6 (as FrameSolver
+  // splits a contact solve between κ updates), a fresh watcher per chunk never sees a full
+  // window of kWindow = 10, one watcher for all chunks does.
+  const auto chunks_until_stagnation = [](bool shared) {
+    NoisyQuadratic objective(4, 1e-9);
+    NewtonSettings settings;
+    settings.tolerance = 1e-12;
+    settings.max_iterations = 6;
+    settings.judge_final_iterate = false;
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(objective.size());
+    NewtonSolver solver;
+    RoundoffStagnation watcher;
+    for (int chunk = 1; chunk <= 20; ++chunk)
+      if (solver.minimize(objective, x, DofMap(4, {}), settings, {}, shared ? &watcher : nullptr)
+              .stagnated)
+        return chunk;
+    return 0;
+  };
+  EXPECT_EQ(chunks_until_stagnation(false), 0);
+  const int shared = chunks_until_stagnation(true);
+  EXPECT_GT(shared, 1);
+  EXPECT_LE(shared, 5);
+}
+
 TEST(Newton, AnUnjudgedSolveWithNoIterationsLeftDoesNothing) {
   NoisyQuadratic objective(2, 0.0);
   NewtonSettings settings;
