@@ -89,11 +89,11 @@ class QuasistaticSimulation {
   /// until the equilibrium test passes or record.newton has used settings.max_iterations. With
   /// `continue_restored`, the first step continues a restored one (xᵗ = previous_).
   /// `restored_iterations`: the frame's iterations before the restore, not in record.
-  /// The Newton settings of the scene's solver at the system's scale.
-  void configure_newton();
   void settle(FrameRecord& record, const NewtonSettings& settings,
               const NewtonSolver::Progress& progress, bool continue_restored,
               int restored_iterations);
+  /// The Newton settings of the scene's solver at the system's scale.
+  void configure_newton();
 
   ShellSystem system_;
   IncrementalPotential potential_;
