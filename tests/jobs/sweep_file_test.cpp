@@ -298,6 +298,10 @@ INSTANTIATE_TEST_SUITE_P(
                  "progressive, coarse_prolonged",
                  5},
         BadSweep{"method = 2\n", "'method' must name a method (got 2); valid methods: direct", 3},
+        BadSweep{"depth = 2\nmethod = \"Direct\"\n",
+                 "'method' must name a method, did you mean \"direct\"? (got \"Direct\"); valid "
+                 "methods: direct, direct_final, progressive, coarse_prolonged",
+                 4},
         BadSweep{"method = \"progressive\"\n",
                  "method \"progressive\" solves a hierarchy, which needs 'depth' 2 or more (got 1)",
                  3},
