@@ -75,6 +75,7 @@ class DirectLevelSolver final : public LevelSolver {
   DirectLevelSolver(const Scene& scene, const CoarseProblem& coarse,
                     std::vector<db::HierarchyCacheUse> uses)
       : to_finest_(coarse.to_finest),
+        finest_rest_(coarse.finest_rest),
         cache_uses_(std::move(uses)),
         simulation_(scene, coarse.shells, coarse.colliders, coarse.loads) {}
 
@@ -113,6 +114,9 @@ class DirectLevelSolver final : public LevelSolver {
     return as_positions(to_finest_ ? to_finest_->apply(simulation_.positions())
                                    : simulation_.positions());
   }
+  const Positions& finest_rest_positions() const override {
+    return to_finest_ ? finest_rest_ : simulation_.system().rest_mesh().vertices;
+  }
   std::vector<db::HierarchyCacheUse> hierarchy_cache_uses() const override { return cache_uses_; }
 
   bool settles_frame(int frame) const override { return simulation_.frame_settles(frame); }
@@ -128,6 +132,7 @@ class DirectLevelSolver final : public LevelSolver {
  private:
   /// P^l of a coarse solve; none on the finest mesh.
   std::optional<SystemProlongation> to_finest_;
+  Positions finest_rest_;  ///< of a coarse solve; empty on the finest mesh
   std::vector<db::HierarchyCacheUse> cache_uses_;
   QuasistaticSimulation simulation_;
 };
@@ -176,6 +181,9 @@ class ProgressiveLevelSolver final : public LevelSolver {
   }
   Positions finest_positions() const override {
     return as_positions(simulation_.finest_positions());
+  }
+  const Positions& finest_rest_positions() const override {
+    return simulation_.finest_system().rest_mesh().vertices;
   }
   bool settles_frame(int frame) const override { return simulation_.frame_settles(frame); }
   std::map<std::string, double> state() const override { return simulation_.schedule_state(); }

@@ -307,7 +307,8 @@ CoarseProblem ProgressiveSimulation::coarse_problem(int level) const {
   return {.shells = level_shells(level),
           .colliders = level_colliders(level),
           .loads = to_finest.apply_linear_transpose(finest_.loads()),
-          .to_finest = to_finest};
+          .to_finest = to_finest,
+          .finest_rest = finest_.rest_mesh().vertices};
 }
 
 ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {

@@ -64,12 +64,14 @@ std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
 /// A level below the finest as a problem of its own, for a direct solve of that level whose
 /// answer is prolonged to the finest mesh (the paper's coarse baseline): its shells' rest meshes
 /// with their pin groups, its colliders' meshes, the finest loads carried to it by Uᵀ (by virtual
-/// work, so the level carries the same total force), and P^l to the finest mesh.
+/// work, so the level carries the same total force), P^l to the finest mesh, and the finest
+/// rest positions, against which the prolonged answer's displacement is measured.
 struct CoarseProblem {
   std::vector<LevelShellMesh> shells;
   std::vector<TriMesh> colliders;
   Eigen::VectorXd loads;
   SystemProlongation to_finest;
+  Positions finest_rest;
 };
 
 /// One step of a progressive solve.
