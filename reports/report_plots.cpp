@@ -19,7 +19,6 @@ constexpr std::size_t kMaxLegendFrames = 10;
 
 std::string job_label(const JobReport& job) { return fmt::format("#{}", job.number); }
 
-
 /// A probe plot leaves out a component that stays below this fraction of the largest magnitude.
 constexpr double kNegligibleComponent = 1e-9;
 
