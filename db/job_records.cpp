@@ -10,6 +10,8 @@ namespace {
 
 constexpr std::array<std::string_view, kAllJobStates.size()> kJobStateNames{
     "queued", "running", "done", "failed", "cancelled", "previewed"};
+constexpr std::array<std::string_view, kAllMethods.size()> kMethodNames{
+    "direct", "direct_final", "progressive", "coarse_prolonged"};
 constexpr std::array<std::string_view, 3> kLevelStatusNames{"running", "done", "failed"};
 
 template <class Enum, std::size_t N>
@@ -29,6 +31,18 @@ std::string_view to_string(JobState state) {
 JobState job_state_from_string(std::string_view name) {
   return from_name<JobState>(kJobStateNames, name, "job state");
 }
+
+std::string_view to_string(Method method) { return kMethodNames[static_cast<std::size_t>(method)]; }
+
+Method method_from_string(std::string_view name) {
+  return from_name<Method>(kMethodNames, name, "method");
+}
+
+bool uses_hierarchy(Method method) {
+  return method == Method::progressive || method == Method::coarse_prolonged;
+}
+
+Method method_of_depth(int depth) { return depth > 1 ? Method::progressive : Method::direct; }
 
 std::string_view to_string(LevelStatus status) {
   return kLevelStatusNames[static_cast<std::size_t>(status)];

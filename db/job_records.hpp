@@ -40,13 +40,35 @@ LevelStatus level_status_from_string(std::string_view name);
 /// ran the levels it was to run before promotion (Job::levels_to_run).
 enum class Outcome { done, failed, failed_permanently, previewed };
 
+/// How a job computes its answer (docs/sweep-format.md, "Methods"): `direct` solves the finest
+/// mesh alone, every frame settled to an equilibrium; `direct_final` solves it with the schedule
+/// of a progressive solve's finest level (frames before the refine frame one step each, the
+/// refine frame and those after it settled), the direct baseline of a final-frame answer;
+/// `progressive` solves a hierarchy from its coarsest level to the finest; `coarse_prolonged`
+/// solves the coarsest mesh of a hierarchy directly, with its own elastics, and prolongs that
+/// answer to the finest mesh, the paper's coarse baseline.
+enum class Method { direct, direct_final, progressive, coarse_prolonged };
+inline constexpr std::array kAllMethods{Method::direct, Method::direct_final,
+                                        Method::progressive, Method::coarse_prolonged};
+/// Whether a job of `method` builds a hierarchy (and so has a depth of 2 or more).
+bool uses_hierarchy(Method method);
+std::string_view to_string(Method method);
+/// Throws std::invalid_argument for a name that is not a method.
+Method method_from_string(std::string_view name);
+/// The method of a job that names none (every job before methods existed): direct at depth 1,
+/// progressive above.
+Method method_of_depth(int depth);
+
 /// A job as a sweep submits it. `id` is the hash of the canonical parameters (computed by the
 /// sweep expansion); the same id always means the same job.
 struct NewJob {
   std::string id;
   nlohmann::json parameters;  ///< stored canonically: keys sorted, compact
   std::string scene;          ///< the scene file
-  int depth = 1;              ///< number of hierarchy levels (1: a direct solve)
+  /// Levels the job solves and records: the hierarchy depth of a progressive job, 1 for a
+  /// direct or coarse-prolonged one (whose hierarchy depth is in its parameters).
+  int depth = 1;
+  Method method = Method::direct;
   int max_attempts = 3;       ///< failed attempts allowed before the job stays failed
   /// Levels run before the job waits for promotion (a coarse-first sweep); empty: all.
   std::optional<int> preview_levels = std::nullopt;
@@ -65,7 +87,8 @@ struct Job {
   std::string id;
   nlohmann::json parameters;
   std::string scene;
-  int depth = 1;
+  int depth = 1;  ///< levels it solves and records (NewJob::depth)
+  Method method = Method::direct;
   JobState state = JobState::queued;
   /// Claims so far: the fencing token of the latest claim. Never decreases, not even on retry,
   /// so a token handed out once is never valid again after a new claim.

@@ -65,7 +65,7 @@ constexpr const char* kJobColumns =
     "jobs.id, jobs.parameters, jobs.scene, jobs.depth, jobs.state, jobs.attempt, jobs.failures, "
     "jobs.max_attempts, jobs.lease_owner, jobs.lease_expiry, jobs.heartbeat_at, jobs.error, "
     "jobs.code_version, jobs.host, jobs.started_at, jobs.ended_at, jobs.created_at, "
-    "jobs.preview_levels, jobs.promoted";
+    "jobs.preview_levels, jobs.promoted, jobs.method";
 
 Job read_job(const Statement& row) {
   Job job;
@@ -85,6 +85,7 @@ Job read_job(const Statement& row) {
   job.created_at = row.real(16);
   if (!row.is_null(17)) job.preview_levels = static_cast<int>(row.integer(17));
   job.promoted = row.integer(18) != 0;
+  job.method = method_from_string(row.text(19));
   return job;
 }
 
@@ -180,6 +181,11 @@ void validate_new_job(const std::string& sweep, const NewJob& job) {
     fail(fmt::format("depth {} is not a number of levels; use 1 or more", job.depth));
   if (job.max_attempts < 1)
     fail(fmt::format("max attempts {} must be at least 1", job.max_attempts));
+  // A progressive job records every level of its hierarchy; the others solve one mesh.
+  if ((job.method == Method::progressive) != (job.depth > 1))
+    fail(fmt::format("a {} job solves {}, not {}", to_string(job.method),
+                     job.method == Method::progressive ? "2 levels or more" : "1 level",
+                     job.depth));
 }
 
 }  // namespace
@@ -226,8 +232,8 @@ SweepAddition JobStore::add_jobs(const std::string& name, const std::string& sou
   }
   auto stored = connection_.prepare("SELECT parameters FROM jobs WHERE id = ?1");
   auto insert = connection_.prepare(
-      "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at, preview_levels) "
-      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
+      "INSERT INTO jobs (id, parameters, scene, depth, max_attempts, created_at, preview_levels, "
+      "method) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
   // A job listed again keeps the most levels any sweep asks of it: none stops it earlier, and
   // one that wants more (all of them: NULL) sends a waiting preview back to the queue.
   auto widen = connection_.prepare(
@@ -250,7 +256,7 @@ SweepAddition JobStore::add_jobs(const std::string& name, const std::string& sou
       widen.reset().bind_all(job.id, job.preview_levels).run();
     } else {
       insert.reset().bind_all(job.id, parameters, job.scene, job.depth, job.max_attempts, time,
-                              job.preview_levels);
+                              job.preview_levels, std::string(to_string(job.method)));
       insert.run();
       addition.added.push_back(job.id);
     }

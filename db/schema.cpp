@@ -210,6 +210,14 @@ CREATE TABLE probe_readings (
 ) WITHOUT ROWID;
 )sql";
 
+// Version 9: each job's solution method (docs/sweep-format.md, "Methods"). A job stored before
+// methods existed was direct at depth 1 and progressive above it.
+constexpr const char* kJobMethods = R"sql(
+ALTER TABLE jobs ADD COLUMN method TEXT NOT NULL DEFAULT 'direct'
+  CHECK (method IN ('direct', 'direct_final', 'progressive', 'coarse_prolonged'));
+UPDATE jobs SET method = 'progressive' WHERE depth > 1;
+)sql";
+
 // Append new migrations here; never edit one that has shipped.
 constexpr std::array kMigrations{
     Migration{1, "sweeps, jobs with leases, per-level records", kInitialSchema},
@@ -221,6 +229,7 @@ constexpr std::array kMigrations{
               true},
     Migration{7, "hierarchy cache uses: hits, builds and their seconds", kHierarchyCacheUses},
     Migration{8, "per-frame load scale and probe readings", kFrameProbes},
+    Migration{9, "the solution method of each job", kJobMethods},
 };
 
 constexpr const char* kVersionTable = R"sql(

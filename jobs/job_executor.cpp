@@ -141,7 +141,7 @@ class JobRun {
     run_.remove_stale_temporaries();
     try {
       scene_ = job_scene(claim_.job);
-      solver_ = factory_(scene_, claim_.job.depth);
+      solver_ = factory_(scene_, claim_.job.method, hierarchy_depth(claim_.job));
       record_hierarchy_cache_uses();
       resume();
       while (true) {
@@ -471,9 +471,14 @@ class JobRun {
   }
 
   /// What the finished level computed (db::kLevelOutputs), by which coarse-first rules select.
+  /// The job's last level is its answer, measured on the finest mesh like every method's (a
+  /// coarse-prolonged job's one level after prolongation); a preview level on its own mesh.
   std::map<std::string, double> level_outputs() const {
-    const Positions& rest = solver_->level_rest_mesh().vertices;
-    const Positions positions = as_positions(solver_->positions());
+    const bool answer = solver_->level() + 1 == solver_->level_count();
+    const Positions& rest =
+        answer ? solver_->finest_rest_positions() : solver_->level_rest_mesh().vertices;
+    const Positions positions =
+        answer ? solver_->finest_positions() : as_positions(solver_->positions());
     std::map<std::string, double> outputs{
         {"max_displacement", (positions - rest).rowwise().norm().maxCoeff()},
         {"iterations", static_cast<double>(steps_taken())},

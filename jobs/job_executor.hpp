@@ -17,8 +17,9 @@
 
 namespace psq::jobs {
 
-/// Builds the solver of a job: its scene and its hierarchy depth.
-using SolverFactory = std::function<std::unique_ptr<LevelSolver>(const Scene&, int depth)>;
+/// Builds the solver of a job: its scene, its method and its hierarchy depth (hierarchy_depth).
+using SolverFactory =
+    std::function<std::unique_ptr<LevelSolver>(const Scene&, db::Method, int depth)>;
 
 struct ExecutorSettings {
   /// An in-level snapshot is written after this many Newton iterations since the last one...

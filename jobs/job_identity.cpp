@@ -14,11 +14,15 @@ std::string file_content_hash(const std::filesystem::path& file) {
 }
 
 nlohmann::json canonical_parameters(const std::string& scene_hash, const Overrides& overrides,
-                                    int depth) {
+                                    int depth, db::Method method) {
   nlohmann::json by_path = nlohmann::json::object();
   for (const auto& [path, value] : overrides) by_path[path] = value;
-  return {{"depth", depth}, {"overrides", by_path}, {"scene", scene_hash}};
+  nlohmann::json parameters = {{"depth", depth}, {"overrides", by_path}, {"scene", scene_hash}};
+  if (method != db::method_of_depth(depth)) parameters["method"] = db::to_string(method);
+  return parameters;
 }
+
+int hierarchy_depth(const db::Job& job) { return job.parameters.value("depth", job.depth); }
 
 std::string job_id(const nlohmann::json& canonical) {
   return fmt::format("{:016x}", Fnv1a64().update(canonical.dump()).value());

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "db/job_records.hpp"
+
 namespace psq::jobs {
 
 /// Scene parameter overrides by dotted path ("shell.cloth.material.thickness" → 5e-4). A std::map
@@ -22,10 +24,17 @@ std::string file_content_hash(const std::filesystem::path& file);
 
 /// The canonical parameters of a job:
 ///   {"depth": d, "overrides": {path: value, ...}, "scene": "<scene content hash>"}
+/// and "method": "<name>" when the method is not the one its depth implies
+/// (db::method_of_depth), so that direct and progressive jobs keep the ids they had before
+/// methods existed. `depth` is the hierarchy depth (1 for a direct job).
 /// nlohmann::json objects keep keys sorted, and compact dumps print doubles in the shortest
 /// form that reads back exactly, so equal parameters always dump to equal text.
 nlohmann::json canonical_parameters(const std::string& scene_hash, const Overrides& overrides,
-                                    int depth);
+                                    int depth, db::Method method);
+
+/// The depth of a job's hierarchy, from its canonical parameters: its levels for a progressive
+/// job, the hierarchy whose coarsest level a coarse-prolonged job solves, 1 for a direct job.
+int hierarchy_depth(const db::Job& job);
 
 /// The job id: 16 hex digits of the 64-bit FNV-1a hash of the compact dump of the canonical
 /// parameters. Not cryptographic; with n jobs the chance of any collision is about n²/2⁶⁵

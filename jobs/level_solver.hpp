@@ -84,6 +84,8 @@ class LevelSolver {
   [[nodiscard]] virtual std::vector<PartRange> level_parts() const = 0;
   /// The current level's state prolonged to the finest mesh (positions() at the finest level).
   [[nodiscard]] virtual Positions finest_positions() const = 0;
+  /// The rest positions of the finest mesh, from which finest_positions() is displaced.
+  [[nodiscard]] virtual const Positions& finest_rest_positions() const = 0;
   /// Whether frame `frame` of the current level ends with settling steps to a static equilibrium
   /// (engine/sim/settling.hpp): then the step norm of its last Newton record is its static
   /// residual.

@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <system_error>
+#include <utility>
 
 #include "engine/core/error.hpp"
 #include "engine/core/input_file.hpp"
@@ -22,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kDepth = "depth";
+const std::string kMethod = "method";
 const std::string kRefine = "refine";
 /// A job's levels are its depth, which replaces the scene's [hierarchy] levels.
 const std::string kSceneLevels = "hierarchy.levels";
@@ -54,7 +56,8 @@ class SweepReader {
       : file_(std::move(file)), document_(parse(text)) {}
 
   Sweep read() {
-    allow_only(document_, {"name", "scene", kDepth, "grid", "zip", kRefine}, "at the top level");
+    allow_only(document_, {"name", "scene", kDepth, kMethod, "grid", "zip", kRefine},
+               "at the top level");
     Sweep sweep;
     sweep.file = file_;
     sweep.name = required_string("name");
@@ -64,11 +67,13 @@ class SweepReader {
     const SceneDocument base = SceneDocument::read(sweep.scene);
     const std::vector<Axis> axes = read_axes(base);
     check_job_count(axes);
-    const Value depth = default_depth(axes);
+    const std::map<std::string, Value> defaults = top_level_defaults(axes);
     std::map<std::string, std::size_t> index_of_id;
     for_each_combination(axes, [&](const std::vector<std::size_t>& pick) {
-      SweepJob job = make_job(base, sweep.scene_hash, axes, pick, depth);
+      auto [job, depth_ignored] = make_job(base, sweep.scene_hash, axes, pick, defaults);
       const auto [it, inserted] = index_of_id.emplace(job.id, sweep.jobs.size());
+      // A job of a method without a hierarchy is the same at every depth: listed once.
+      if (!inserted && depth_ignored) return;
       if (!inserted)
         fail(0, fmt::format("jobs {} and {} have the same parameters ({}); a value is listed twice",
                             it->second + 1, sweep.jobs.size() + 1, describe_parameters(job)));
@@ -183,7 +188,7 @@ class SweepReader {
         fail(line, fmt::format("'{}' has no effect in a job, whose levels are its depth; vary "
                                "'{}' instead",
                                kSceneLevels, kDepth));
-      if (path != kDepth) {
+      if (path != kDepth && path != kMethod) {
         try {
           base.check_path(path);
         } catch (const OverrideError& error) {
@@ -231,15 +236,22 @@ class SweepReader {
                           count, kMaxJobs));
   }
 
-  /// The depth of jobs whose axes do not vary it: the top-level `depth`, 1 if absent.
-  Value default_depth(const std::vector<Axis>& axes) const {
-    const toml::node* node = document_.get(kDepth);
-    if (!node) return {1, 0};
-    for (const Axis& axis : axes)
-      for (const std::string& path : axis.paths)
-        if (path == kDepth)
-          fail(line_of(*node), "'depth' is given at the top level and varied; give it once");
-    return {scalar_json(*node), line_of(*node)};
+  /// The `depth` and `method` of jobs whose axes do not vary them, as the top level gives
+  /// them; absent when it does not (depth 1, the method the depth implies).
+  std::map<std::string, Value> top_level_defaults(const std::vector<Axis>& axes) const {
+    std::map<std::string, Value> defaults;
+    for (const std::string& key : {kDepth, kMethod}) {
+      const toml::node* node = document_.get(key);
+      if (!node) continue;
+      for (const Axis& axis : axes)
+        for (const std::string& path : axis.paths)
+          if (path == key)
+            fail(line_of(*node),
+                 fmt::format("'{}' is given at the top level and varied; give it once", key));
+      defaults[key] = {scalar_json(*node), line_of(*node)};
+    }
+    if (!defaults.count(kDepth)) defaults[kDepth] = {1, 0};
+    return defaults;
   }
 
   /// Calls `visit` with every combination of one index per axis, the last axis fastest.
@@ -264,17 +276,18 @@ class SweepReader {
     return canonical_values_[key] = base.canonical_override(path, value.raw);
   }
 
-  /// The job at `pick`, its values made canonical and applied to the base scene. An impossible
-  /// value is reported at its line with the job's parameters; values that are possible alone
-  /// but not together (e.g. an edge length and a width) at the line of the first.
-  SweepJob make_job(const SceneDocument& base, const std::string& scene_hash,
-                    const std::vector<Axis>& axes, const std::vector<std::size_t>& pick,
-                    const Value& depth_default) const {
-    std::map<std::string, Value> chosen;
+  /// The job at `pick`, its values made canonical and applied to the base scene, and whether
+  /// its depth was set aside (a direct job's). An impossible value is reported at its line with
+  /// the job's parameters; values that are possible alone but not together (e.g. an edge length
+  /// and a width) at the line of the first.
+  std::pair<SweepJob, bool> make_job(const SceneDocument& base, const std::string& scene_hash,
+                                     const std::vector<Axis>& axes,
+                                     const std::vector<std::size_t>& pick,
+                                     const std::map<std::string, Value>& defaults) const {
+    std::map<std::string, Value> chosen = defaults;
     for (std::size_t a = 0; a < axes.size(); ++a)
       for (std::size_t p = 0; p < axes[a].paths.size(); ++p)
         chosen[axes[a].paths[p]] = axes[a].columns[p][pick[a]];
-    if (!chosen.count(kDepth)) chosen[kDepth] = depth_default;
 
     SweepJob job;
     auto fail_job = [&](const Value& value, const std::string& message) {
@@ -292,6 +305,7 @@ class SweepReader {
         job.depth = value.raw.get<int>();
         continue;
       }
+      if (path == kMethod) continue;  // read once the depth is known, below
       try {
         job.overrides[path] = canonical(base, path, value);
       } catch (const OverrideError& error) {
@@ -306,9 +320,48 @@ class SweepReader {
         fail_job(chosen.at(job.overrides.begin()->first), error.what());
       }
     }
-    job.parameters = canonical_parameters(scene_hash, job.overrides, job.depth);
+    bool depth_ignored = false;
+    if (const auto method = chosen.find(kMethod); method != chosen.end()) {
+      const std::optional<db::Method> named = named_method(method->second.raw);
+      if (!named) fail_job(method->second, method_refusal(method->second.raw));
+      job.method = *named;
+      if (!db::uses_hierarchy(job.method)) depth_ignored = std::exchange(job.depth, 1) != 1;
+      else if (job.depth < 2)
+        fail_job(method->second,
+                 fmt::format("method \"{}\" solves a hierarchy, which needs 'depth' 2 or more "
+                             "(got {}); give the sweep a depth of 2 or more",
+                             db::to_string(job.method), job.depth));
+    } else {
+      job.method = db::method_of_depth(job.depth);
+    }
+    job.parameters = canonical_parameters(scene_hash, job.overrides, job.depth, job.method);
     job.id = job_id(job.parameters);
-    return job;
+    return {std::move(job), depth_ignored};
+  }
+
+  static std::vector<std::string> method_names() {
+    std::vector<std::string> names;
+    for (const db::Method method : db::kAllMethods) names.emplace_back(db::to_string(method));
+    return names;
+  }
+
+  /// The method `value` names, if it names one.
+  static std::optional<db::Method> named_method(const nlohmann::json& value) {
+    const std::vector<std::string> names = method_names();
+    if (!value.is_string() ||
+        std::find(names.begin(), names.end(), value.get<std::string>()) == names.end())
+      return std::nullopt;
+    return db::method_from_string(value.get<std::string>());
+  }
+
+  /// Why `value` is not a method, with the nearest name and the valid ones.
+  static std::string method_refusal(const nlohmann::json& value) {
+    const std::vector<std::string> names = method_names();
+    const auto nearest =
+        value.is_string() ? suggest_key(value.get<std::string>(), names) : std::nullopt;
+    return fmt::format("'{}' must name a method{} (got {}); valid methods: {}", kMethod,
+                       nearest ? fmt::format(", did you mean \"{}\"?", *nearest) : "",
+                       value.dump(), fmt::join(names, ", "));
   }
 
   // ---- refine: coarse-first sweeps ------------------------------------------------------------
@@ -481,14 +534,16 @@ class SweepReader {
     const toml::node* preview =
         node.is_table() ? node.as_table()->get("preview") : nullptr;
     for (const SweepJob& job : sweep.jobs) {
-      const int levels = sweep.refine.preview_levels(job.depth);
-      if (levels < 1 || levels >= job.depth)
+      const int levels = sweep.refine.preview_levels(job.levels());
+      if (levels < 1 || levels >= job.levels())
         fail(line_of(preview ? *preview : node),
              fmt::format("job {}: a coarse-first job needs preview levels in [1, depth − 1], "
-                         "but it has depth {} and {} preview level{}; {}",
-                         describe_parameters(job), job.depth, levels, levels == 1 ? "" : "s",
-                         job.depth < 2 ? "give the sweep depth 2 or more"
-                                       : "lower 'preview' below the depth"));
+                         "but it solves {} level{} and has {} preview level{}; {}",
+                         describe_parameters(job), job.levels(), job.levels() == 1 ? "" : "s",
+                         levels, levels == 1 ? "" : "s",
+                         job.levels() < 2 ? "give the sweep depth 2 or more and the method "
+                                            "\"progressive\""
+                                          : "lower 'preview' below the depth"));
       if (sweep.refine.kind == db::RefineKind::changed && levels < 2)
         fail(line_of(preview ? *preview : node),
              fmt::format("job {}: rule = \"changed\" compares the last two preview levels, but "
@@ -515,7 +570,7 @@ Sweep read_sweep_text(std::string_view text, const fs::path& file) {
 }
 
 std::string describe_parameters(const SweepJob& job) {
-  std::string text = fmt::format("depth={}", job.depth);
+  std::string text = fmt::format("depth={} method={}", job.depth, db::to_string(job.method));
   for (const auto& [path, value] : job.overrides) text += fmt::format(" {}={}", path, value.dump());
   return text;
 }
@@ -526,9 +581,10 @@ std::vector<db::NewJob> new_jobs(const Sweep& sweep) {
     jobs.push_back({.id = job.id,
                     .parameters = job.parameters,
                     .scene = sweep.scene.string(),
-                    .depth = job.depth,
+                    .depth = job.levels(),
+                    .method = job.method,
                     .preview_levels = sweep.refine.previews()
-                                          ? std::optional(sweep.refine.preview_levels(job.depth))
+                                          ? std::optional(sweep.refine.preview_levels(job.levels()))
                                           : std::nullopt});
   return jobs;
 }

@@ -16,10 +16,13 @@ namespace psq::jobs {
 
 /// One expanded job of a sweep.
 struct SweepJob {
-  Overrides overrides;        ///< canonical values (see canonical_override)
-  int depth = 1;              ///< hierarchy levels
-  nlohmann::json parameters;  ///< canonical_parameters(scene hash, overrides, depth)
+  Overrides overrides;  ///< canonical values (see canonical_override)
+  int depth = 1;        ///< hierarchy levels (1 for a direct job)
+  db::Method method = db::Method::direct;
+  nlohmann::json parameters;  ///< canonical_parameters(scene hash, overrides, depth, method)
   std::string id;             ///< job_id(parameters)
+  /// The levels the job solves and records: its hierarchy's for a progressive job, else one.
+  int levels() const { return method == db::Method::progressive ? depth : 1; }
 };
 
 /// A sweep file, expanded.
@@ -53,8 +56,8 @@ Sweep read_sweep(const std::filesystem::path& file);
 /// callers that hold the text already, such as the fuzz target.
 Sweep read_sweep_text(std::string_view text, const std::filesystem::path& file);
 
-/// "depth=1 shell.cloth.material.thickness=0.0005 ...": a job's parameters on one line, paths
-/// sorted.
+/// "depth=1 method=direct shell.cloth.material.thickness=0.0005 ...": a job's parameters on one
+/// line, paths sorted.
 std::string describe_parameters(const SweepJob& job);
 
 /// The jobs of a sweep as the store takes them.

@@ -242,6 +242,8 @@ std::string html_report(const SweepReport& report, Gnuplot& gnuplot) {
     body += fmt::format("<h2>Coarse-first selection</h2>\n<p>{}</p>\n{}{}",
                         escape_html(db::describe(report.refine)), html_table(previews),
                         preview_gallery(report));
+  if (const Table speedups = speedup_table(report); !speedups.rows.empty())
+    body += "<h2>Speed-ups over the direct solves</h2>\n" + html_table(speedups);
   body += "<h2>Levels</h2>\n" + html_table(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     body += "<h2>Refinements</h2>\n" + html_table(refinements);

@@ -9,6 +9,7 @@
 #include "db/job_store.hpp"
 #include "engine/core/checksum.hpp"
 #include "engine/io/checkpoint.hpp"
+#include "jobs/job_identity.hpp"
 #include "jobs/run_directory.hpp"
 #include "reports/level_metrics.hpp"
 #include "reports/parameters.hpp"
@@ -136,10 +137,18 @@ void add_finest_results(const std::vector<std::optional<LevelCheckpoint>>& check
                         JobReport& job) {
   if (!checkpoints.back()) return;
   const Checkpoint& finest = checkpoints.back()->checkpoint;
-  try {
-    job.outputs.max_displacement = max_point_distance(finest.positions, finest.rest_positions);
-  } catch (const std::invalid_argument& e) {
-    job.problems.push_back(fmt::format("finest level: positions against rest shape: {}", e.what()));
+  // The executor measures the answer on the finest mesh, where a coarse-prolonged job's
+  // checkpoint holds no rest shape; stores before level outputs have only the checkpoint.
+  const std::map<std::string, double>& stored = job.levels.back().outputs;
+  if (const auto displacement = stored.find("max_displacement"); displacement != stored.end()) {
+    job.outputs.max_displacement = displacement->second;
+  } else {
+    try {
+      job.outputs.max_displacement = max_point_distance(finest.positions, finest.rest_positions);
+    } catch (const std::invalid_argument& e) {
+      job.problems.push_back(
+          fmt::format("finest level: positions against rest shape: {}", e.what()));
+    }
   }
   if (const auto energy = finest.solver.scalars.find(kElasticEnergyScalar);
       energy != finest.solver.scalars.end())
@@ -232,6 +241,20 @@ HierarchyCacheSummary summarize_cache_uses(const std::vector<db::HierarchyCacheU
       summary.saved_seconds += built->second.first / built->second.second - use.seconds;
   }
   return summary;
+}
+
+std::string method_label(const db::Job& job) {
+  switch (job.method) {
+    case db::Method::direct:
+      return "direct";
+    case db::Method::direct_final:
+      return "direct, settled from the refine frame";
+    case db::Method::progressive:
+      return fmt::format("progressive, {} levels", job.depth);
+    case db::Method::coarse_prolonged:
+      return fmt::format("coarse of {} levels, prolonged", jobs::hierarchy_depth(job));
+  }
+  return "unknown method";
 }
 
 SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {

@@ -76,6 +76,10 @@ struct JobOutputs {
   std::optional<double> total_seconds;     ///< sum of the levels' seconds
 };
 
+/// How a job computed its answer, for legends and tables: "direct", "direct, settled from the
+/// refine frame", "progressive, N levels" or "coarse of N levels, prolonged".
+std::string method_label(const db::Job& job);
+
 /// One job of the sweep.
 struct JobReport {
   int number = 0;  ///< 1-based position in the sweep: the label used in plots and tables

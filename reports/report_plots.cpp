@@ -19,11 +19,6 @@ constexpr std::size_t kMaxLegendFrames = 10;
 
 std::string job_label(const JobReport& job) { return fmt::format("#{}", job.number); }
 
-/// "direct" for a one-level job, else "progressive, N levels".
-std::string method_label(const JobReport& job) {
-  return job.job.depth == 1 ? "direct" : fmt::format("progressive, {} levels", job.job.depth);
-}
-
 /// A probe plot leaves out a component that stays below this fraction of the largest magnitude.
 constexpr double kNegligibleComponent = 1e-9;
 
@@ -271,7 +266,7 @@ PlotSpec error_against_time_plot(const SweepReport& report) {
   plot.log_y = true;
   for (const JobReport& job : report.jobs) {
     if (!job.finished()) continue;
-    PlotSeries series{fmt::format("{} ({})", job_label(job), method_label(job)), {}, {}};
+    PlotSeries series{fmt::format("{} ({})", job_label(job), method_label(job.job)), {}, {}};
     double elapsed = 0.0;
     for (const LevelReport& level : job.levels) {
       if (!level.seconds) break;

@@ -26,7 +26,7 @@ PlotSpec time_per_level_plot(const SweepReport& report);
 
 /// Error to the finest level against the run time so far (the sum of the seconds of the
 /// levels up to and including it), log scales, one curve per finished job through its levels,
-/// labelled with its method (direct, or progressive with its depth). The finest level's error
+/// labelled with its method (method_label). The finest level's error
 /// is 0 and cannot be drawn on a log scale.
 PlotSpec error_against_time_plot(const SweepReport& report);
 

@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <iterator>
+
 #include "reports/html_text.hpp"
 #include "reports/parameters.hpp"
 
@@ -33,6 +37,21 @@ std::optional<double> level_output(const JobReport& job, int level, const std::s
   const auto found = outputs.find(name);
   if (found == outputs.end()) return std::nullopt;
   return found->second;
+}
+
+/// What makes jobs the same design point whatever their method: their scene and overrides.
+std::string design_point(const db::Job& job) {
+  return job.parameters.value("scene", "") +
+         job.parameters.value("overrides", nlohmann::json::object()).dump();
+}
+
+/// The finished job of `method` at `job`'s design point, if the sweep has one.
+const JobReport* baseline_of(const SweepReport& report, const JobReport& job, db::Method method) {
+  for (const JobReport& other : report.jobs)
+    if (other.finished() && other.job.method == method &&
+        design_point(other.job) == design_point(job.job))
+      return &other;
+  return nullptr;
 }
 
 }  // namespace
@@ -180,6 +199,42 @@ Table refinements_table(const SweepReport& report) {
       }
       table.rows.push_back(std::move(row));
     }
+  return table;
+}
+
+Table speedup_table(const SweepReport& report) {
+  // The method column names the depth and the method: the other swept parameters give the point.
+  std::vector<std::string> point_parameters;
+  std::copy_if(report.swept_parameters.begin(), report.swept_parameters.end(),
+               std::back_inserter(point_parameters),
+               [](const std::string& name) { return name != "depth" && name != "method"; });
+  Table table;
+  table.header = {"#", "id"};
+  table.header.insert(table.header.end(), point_parameters.begin(), point_parameters.end());
+  for (const char* column :
+       {"method", "time (s)", "direct_final time (s)", "speed-up over direct_final",
+        "direct time (s)", "speed-up over direct"})
+    table.header.push_back(column);
+  for (const JobReport& job : report.jobs) {
+    if (!job.finished() || !db::uses_hierarchy(job.job.method) || !job.outputs.total_seconds)
+      continue;
+    const std::array baselines{baseline_of(report, job, db::Method::direct_final),
+                               baseline_of(report, job, db::Method::direct)};
+    if (!baselines[0] && !baselines[1]) continue;
+    std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
+    for (const std::string& name : point_parameters) row.push_back(parameter_cell(job, name));
+    row.push_back(method_label(job.job));
+    row.push_back(readable_number(job.outputs.total_seconds));
+    for (const JobReport* baseline : baselines) {
+      const std::optional<double> seconds =
+          baseline ? baseline->outputs.total_seconds : std::nullopt;
+      row.push_back(readable_number(seconds));
+      row.push_back(readable_number(seconds && *job.outputs.total_seconds > 0
+                                        ? std::optional(*seconds / *job.outputs.total_seconds)
+                                        : std::nullopt));
+    }
+    table.rows.push_back(std::move(row));
+  }
   return table;
 }
 

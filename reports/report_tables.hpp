@@ -40,6 +40,15 @@ Table refinements_table(const SweepReport& report);
 /// and of the finest level. No rows for an ordinary sweep (refine = "all").
 Table preview_table(const SweepReport& report);
 
+/// Speed-ups of the hierarchy methods over the direct ones: one row per finished progressive or
+/// coarse-prolonged job that has a finished direct baseline of the same scene and overrides —
+/// number, short id, swept parameters, method, its time, then for the baseline `direct_final`
+/// (the progressive finest level's settling schedule on the finest mesh: the honest baseline of
+/// a final-frame answer) and for `direct` (every frame settled) the baseline's time and the
+/// speed-up (baseline time over the job's); empty cells where that baseline is missing. No rows
+/// when the sweep has no such pair.
+Table speedup_table(const SweepReport& report);
+
 /// The hierarchy cache in one sentence: hits, builds, their seconds and the time the hits saved
 /// (docs/reports.md).
 std::string cache_summary_text(const HierarchyCacheSummary& cache);

@@ -18,6 +18,8 @@ std::string summary_markdown(const SweepReport& report) {
   if (const Table previews = preview_table(report); !previews.rows.empty())
     text += fmt::format("\n## Coarse-first selection\n\n{}\n\n{}", db::describe(report.refine),
                         to_markdown(previews));
+  if (const Table speedups = speedup_table(report); !speedups.rows.empty())
+    text += "\n## Speed-ups over the direct solves\n\n" + to_markdown(speedups);
   text += "\n## Levels\n\n" + to_markdown(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     text += "\n## Refinements\n\n" + to_markdown(refinements);

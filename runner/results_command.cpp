@@ -8,6 +8,7 @@
 #include <set>
 
 #include "db/job_store.hpp"
+#include "jobs/job_identity.hpp"
 #include "runner/commands.hpp"
 #include "runner/workspace.hpp"
 
@@ -69,12 +70,13 @@ std::string csv_field(const std::string& text) {
 
 void print_csv(const std::vector<db::JobResult>& results) {
   const std::vector<std::string> columns = parameter_columns(results);
-  std::cout << "job,state,depth";
+  std::cout << "job,state,depth,method";
   for (const std::string& c : columns) std::cout << ',' << csv_field(c);
   std::cout << ",level,level_status,iterations,final_residual,static_residual,wall_seconds,"
                "checkpoint,error\n";
   for (const db::JobResult& r : results) {
-    std::string prefix = fmt::format("{},{},{}", r.job.id, db::to_string(r.job.state), r.job.depth);
+    std::string prefix = fmt::format("{},{},{},{}", r.job.id, db::to_string(r.job.state),
+                                     r.job.depth, db::to_string(r.job.method));
     for (const std::string& c : columns) prefix += "," + csv_field(parameter_value(r.job, c));
     if (r.levels.empty()) std::cout << prefix << ",,,,,,,," << csv_field(r.job.error) << '\n';
     for (const db::LevelRecord& level : r.levels)
@@ -114,6 +116,7 @@ nlohmann::json to_json(const std::string& sweep, const std::vector<db::JobResult
                     {"parameters", r.job.parameters},
                     {"scene", r.job.scene},
                     {"depth", r.job.depth},
+                    {"method", db::to_string(r.job.method)},
                     {"attempt", r.job.attempt},
                     {"failures", r.job.failures},
                     {"preview_levels", r.job.preview_levels ? nlohmann::json(*r.job.preview_levels)
@@ -132,6 +135,12 @@ std::string preview_note(const db::Job& job) {
                      *job.preview_levels == 1 ? "" : "s", job.promoted ? ", promoted" : "");
 }
 
+/// Which hierarchy a coarse-prolonged job solved the coarsest level of; empty for the others.
+std::string coarse_note(const db::Job& job) {
+  if (job.method != db::Method::coarse_prolonged) return "";
+  return fmt::format(" (coarsest of {} levels)", jobs::hierarchy_depth(job));
+}
+
 void print_text(const std::string& sweep, const std::vector<db::JobResult>& results) {
   std::cout << fmt::format("sweep '{}': {} jobs\n", sweep, results.size());
   for (const db::JobResult& r : results) {
@@ -139,8 +148,9 @@ void print_text(const std::string& sweep, const std::vector<db::JobResult>& resu
     const nlohmann::json overrides = overrides_of(r.job);
     for (const auto& [path, value] : overrides.items())
       parameters += fmt::format(" {}={}", path, value.dump());
-    std::cout << fmt::format("{} {:<9} depth={}{}{}\n", r.job.id, db::to_string(r.job.state),
-                             r.job.depth, parameters, preview_note(r.job));
+    std::cout << fmt::format("{} {:<9} depth={} method={}{}{}{}\n", r.job.id,
+                             db::to_string(r.job.state), r.job.depth, db::to_string(r.job.method),
+                             coarse_note(r.job), parameters, preview_note(r.job));
     for (const db::LevelRecord& level : r.levels)
       std::cout << fmt::format("    level {} {:<7} {:>5} iterations  ‖g‖ {:.3e}  {:.2f} s{}\n",
                                level.level, db::to_string(level.status), level.iterations,

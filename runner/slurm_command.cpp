@@ -119,7 +119,7 @@ std::vector<db::NewJob> queued_jobs(db::JobStore& store, const std::string& swee
           "array tasks cannot do yet: run the previews with psq work, then submit the promoted "
           "jobs",
           r.job.id, sweep));
-    jobs.push_back({r.job.id, r.job.parameters, r.job.scene, r.job.depth,
+    jobs.push_back({r.job.id, r.job.parameters, r.job.scene, r.job.depth, r.job.method,
                     static_cast<int>(r.job.max_attempts), std::nullopt});
   }
   return jobs;

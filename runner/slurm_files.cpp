@@ -82,6 +82,7 @@ void write_manifest(const fs::path& file, const Manifest& manifest) {
                     {"parameters", job.parameters},
                     {"scene", job.scene},
                     {"depth", job.depth},
+                    {"method", db::to_string(job.method)},
                     {"max_attempts", job.max_attempts}});
   write_json(file, {{"format", kManifestFormat},
                     {"sweep", manifest.sweep},
@@ -99,12 +100,18 @@ Manifest read_manifest(const fs::path& file) {
     manifest.runs = value.at("runs").get<std::string>();
     manifest.snapshot_iterations = value.at("snapshot_iterations").get<int>();
     manifest.snapshot_seconds = value.at("snapshot_seconds").get<double>();
-    for (const nlohmann::json& job : value.at("jobs"))
+    for (const nlohmann::json& job : value.at("jobs")) {
+      const int depth = job.at("depth").get<int>();
+      // A manifest written before methods existed names none.
+      const db::Method method =
+          job.contains("method") ? db::method_from_string(job.at("method").get<std::string>())
+                                 : db::method_of_depth(depth);
       manifest.jobs.push_back({job.at("id").get<std::string>(), job.at("parameters"),
-                               job.at("scene").get<std::string>(), job.at("depth").get<int>(),
+                               job.at("scene").get<std::string>(), depth, method,
                                job.at("max_attempts").get<int>(), std::nullopt});
+    }
     return manifest;
-  } catch (const nlohmann::json::exception& error) {
+  } catch (const std::exception& error) {  // a JSON error, or a method that is not one
     throw InputError(fmt::format("{}: a damaged SLURM manifest: {}", file.string(), error.what()));
   }
 }

@@ -83,8 +83,9 @@ int work_in_this_process(const WorkSettings& settings, const WorkerPlacement& pl
   options.lease_seconds = settings.lease_seconds;
   if (!settings.sweep.empty()) options.selection = db::JobSelection::sweep(settings.sweep);
   options.executor = {settings.snapshot_iterations, settings.snapshot_seconds, PSQ_VERSION};
-  const auto make_solver = [cache = placement.cache](const Scene& scene, int depth) {
-    return jobs::make_level_solver(scene, depth, cache);
+  const auto make_solver = [cache = placement.cache](const Scene& scene, db::Method method,
+                                                     int depth) {
+    return jobs::make_level_solver(scene, method, depth, cache);
   };
   const jobs::WorkerSummary summary = jobs::run_worker(
       placement.database, placement.runs, make_solver, options, events, stop_requested);

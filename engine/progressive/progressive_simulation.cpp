@@ -302,6 +302,15 @@ Eigen::VectorXd ProgressiveSimulation::finest_positions() const {
   return finest_level() ? x_ : to_finest_[level_].apply(x_);
 }
 
+CoarseProblem ProgressiveSimulation::coarse_problem(int level) const {
+  const SystemProlongation& to_finest = to_finest_.at(level);
+  return {.shells = level_shells(level),
+          .colliders = level_colliders(level),
+          .loads = to_finest.apply_linear_transpose(finest_.loads()),
+          .to_finest = to_finest,
+          .finest_rest = finest_.rest_mesh().vertices};
+}
+
 ProgressiveStep ProgressiveSimulation::step(const Progress& progress) {
   if (level_done())
     throw std::logic_error(fmt::format("ProgressiveSimulation::step: level {} is done", level_));

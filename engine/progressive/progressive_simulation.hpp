@@ -61,6 +61,19 @@ std::vector<MeshHierarchy> build_hierarchies(const ShellSystem& finest,
                                              const ProgressiveSettings& settings,
                                              std::vector<HierarchyCacheUse>* uses = nullptr);
 
+/// A level below the finest as a problem of its own, for a direct solve of that level whose
+/// answer is prolonged to the finest mesh (the paper's coarse baseline): its shells' rest meshes
+/// with their pin groups, its colliders' meshes, the finest loads carried to it by Uᵀ (by virtual
+/// work, so the level carries the same total force), P^l to the finest mesh, and the finest
+/// rest positions, against which the prolonged answer's displacement is measured.
+struct CoarseProblem {
+  std::vector<LevelShellMesh> shells;
+  std::vector<TriMesh> colliders;
+  Eigen::VectorXd loads;
+  SystemProlongation to_finest;
+  Positions finest_rest;
+};
+
 /// One step of a progressive solve.
 struct ProgressiveStep {
   int level = 0;
@@ -148,6 +161,9 @@ class ProgressiveSimulation {
   [[nodiscard]] const Eigen::VectorXd& previous() const { return previous_; }
   /// P^l(x_l) on the finest mesh; positions() itself at the finest level.
   [[nodiscard]] Eigen::VectorXd finest_positions() const;
+  /// Level `level` (below the finest) as a problem of its own.
+  /// @throws std::out_of_range when `level` is not below the finest.
+  [[nodiscard]] CoarseProblem coarse_problem(int level) const;
 
   /// Whether a step to `frame` at the current level is followed by settling steps: when the
   /// scene's frames are equilibria, the refine frame of a hierarchy and every frame of the

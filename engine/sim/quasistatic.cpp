@@ -26,6 +26,24 @@ QuasistaticSimulation::QuasistaticSimulation(const Scene& scene)
       frame_solver_(system_, potential_),
       x_(flat(system_.rest_mesh().vertices)),
       previous_(x_) {
+  configure_newton();
+}
+
+QuasistaticSimulation::QuasistaticSimulation(const Scene& scene,
+                                             const std::vector<LevelShellMesh>& shells,
+                                             const std::vector<TriMesh>& colliders,
+                                             const Eigen::VectorXd& loads)
+    : system_(scene, shells, colliders),
+      potential_(system_, scene.time.step),
+      frame_solver_(system_, potential_),
+      x_(flat(system_.rest_mesh().vertices)),
+      previous_(x_) {
+  system_.set_loads(loads);
+  configure_newton();
+}
+
+void QuasistaticSimulation::configure_newton() {
+  const Scene& scene = system_.scene();
   settings_.step_scale = scene.time.step;
   settings_.max_iterations = scene.solver.max_iterations;
   settings_.project_on_demand = scene.solver.project_on_demand;
@@ -92,8 +110,7 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
     settle_growth_ = next_settling_growth(
         0, record.newton.converged && resumed_iterations + record.newton.iterations == 0);
   }
-  if (system_.scene().solver.frame_solution == FrameSolution::equilibrium &&
-      (record.newton.converged || resumed_in_settling))
+  if (frame_settles(record.frame) && (record.newton.converged || resumed_in_settling))
     settle(record, settings, counted_progress, resumed_in_settling, resumed_iterations);
   settle_growth_ = 0;
   frame_solver_.finish_frame(x_, record);
@@ -101,6 +118,11 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   frame_ = record.frame;
   record.elastic_energy = potential_.elastic_energy(x_);
   return record;
+}
+
+bool QuasistaticSimulation::frame_settles(int frame) const {
+  return system_.scene().solver.frame_solution == FrameSolution::equilibrium &&
+         frame >= first_settled_frame_;
 }
 
 std::map<std::string, double> QuasistaticSimulation::adaptive_state() const {

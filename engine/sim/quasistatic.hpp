@@ -27,6 +27,12 @@ class QuasistaticSimulation {
   /// Builds the shell system of `scene` and starts at its rest state.
   /// @throws InputError when the rest state is not strictly below a shell's strain limit.
   explicit QuasistaticSimulation(const Scene& scene);
+  /// The same on one hierarchy level of `scene` as a problem of its own: the shells' rest
+  /// meshes with their pin groups and the colliders' meshes of that level (ShellSystem's level
+  /// constructor), carrying `loads` (3n, at scale 1) in place of the scene's, which are
+  /// selected on the finest mesh.
+  QuasistaticSimulation(const Scene& scene, const std::vector<LevelShellMesh>& shells,
+                        const std::vector<TriMesh>& colliders, const Eigen::VectorXd& loads);
 
   [[nodiscard]] const ShellSystem& system() const { return system_; }
   /// The state of the last solved frame; inside step() (e.g. in its progress callback), the
@@ -45,7 +51,15 @@ class QuasistaticSimulation {
   /// The strain-limit term, or null when no shell sets a strain limit.
   [[nodiscard]] StrainLimitTerm* strain_limit() { return frame_solver_.strain_limit(); }
 
-  /// Solves the next frame: its step, then (frame_solution = equilibrium) its settling steps. A
+  /// Settles frames `frame`, `frame` + 1, … only; the frames before it take their one step
+  /// (their path, not an equilibrium). The schedule of a progressive solve's finest level, for
+  /// a direct solve whose answer is its last frame; 1 (every frame) unless set.
+  void settle_from_frame(int frame) { first_settled_frame_ = frame; }
+  /// Whether frame `frame`'s step is followed by settling steps: the scene's frames are
+  /// equilibria (frame_solution) and it is not before settle_from_frame's frame.
+  [[nodiscard]] bool frame_settles(int frame) const;
+
+  /// Solves the next frame: its step, then (frame_settles) its settling steps. A
   /// frame that does not converge, or does not settle, within solver.max_iterations is returned
   /// with newton.converged = false; numerical failures throw NumericalError.
   FrameRecord step(const Progress& progress = {});
@@ -78,6 +92,8 @@ class QuasistaticSimulation {
   void settle(FrameRecord& record, const NewtonSettings& settings,
               const NewtonSolver::Progress& progress, bool continue_restored,
               int restored_iterations);
+  /// The Newton settings of the scene's solver at the system's scale.
+  void configure_newton();
 
   ShellSystem system_;
   IncrementalPotential potential_;
@@ -91,6 +107,7 @@ class QuasistaticSimulation {
   /// frame, the restored xᵗ.
   Eigen::VectorXd frame_start_;
   int frame_ = 0;
+  int first_settled_frame_ = 1;  ///< settle_from_frame
   /// Newton iterations already spent on frame_ + 1 before a restore (0: start it afresh).
   int resumed_iterations_ = 0;
   /// Growth index of the settling step being solved; 0 outside settling (the frame's step).

@@ -172,6 +172,14 @@ void ShellSystem::set_load_time(double time) {
   external_force_ = weight_ + load_scale_at(scene_.load_scale, time) * loads_;
 }
 
+void ShellSystem::set_loads(const Eigen::VectorXd& loads) {
+  if (loads.size() != loads_.size())
+    throw std::invalid_argument(fmt::format("ShellSystem::set_loads: {} values for {} DOFs",
+                                            loads.size(), loads_.size()));
+  loads_ = loads;
+  set_load_time(0.0);
+}
+
 ShellSystem::ShellSystem(const Scene& scene, const std::vector<LevelShellMesh>& shells,
                          const std::vector<TriMesh>& colliders)
     : scene_(scene) {

@@ -111,6 +111,14 @@ class ShellSystem {
   /// Sets the time the external force is of: the loads scaled by the scene's load scale at
   /// `time` (scene.hpp, LoadScale); gravity stays as it is.
   void set_load_time(double time);
+  /// The loads at scale 1, per DOF (3n): the scene's on the finest mesh; none on a level
+  /// system unless set_loads gave them.
+  [[nodiscard]] const Eigen::VectorXd& loads() const { return loads_; }
+  /// Replaces the loads at scale 1 (3n, per DOF) by `loads`: a level system solved as a
+  /// problem of its own carries the finest loads transferred to it. The external force is
+  /// that of load time 0 until set_load_time.
+  /// @throws std::invalid_argument when the size does not fit the system.
+  void set_loads(const Eigen::VectorXd& loads);
   /// The scene's probes on this system's vertices, in scene order (none below the finest).
   [[nodiscard]] const std::vector<SystemProbe>& probes() const { return probes_; }
   /// The vertices with at least one fixed component (shell pins, then every collider vertex).

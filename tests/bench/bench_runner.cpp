@@ -74,7 +74,9 @@ int bench_runner(const psq::bench::BenchOptions& options) {
   events.log = [](const std::string& line) { std::cerr << line << '\n'; };
   jobs::JobExecutor executor(
       store, dir / "psq.db", dir / "runs",
-      [](const Scene& scene, int depth) { return jobs::make_level_solver(scene, depth); },
+      [](const Scene& scene, db::Method method, int depth) {
+        return jobs::make_level_solver(scene, method, depth);
+      },
       {.snapshot_iterations = 50, .snapshot_seconds = snapshot_seconds, .code_version = "bench"},
       events, stop);
   const auto start = std::chrono::steady_clock::now();

@@ -116,6 +116,27 @@ TEST(JobStoreSweeps, SameIdWithOtherParametersIsRefused) {
   EXPECT_DOUBLE_EQ(store.find_job("job-0000")->parameters.at("thickness").get<double>(), 1e-3);
 }
 
+TEST(JobStoreSweeps, AJobWhoseMethodDoesNotFitItsLevelsIsRefusedAndMethodsAreKept) {
+  JobStore store(fresh_store_path());
+  auto jobs = thickness_jobs(0, 3, 1);
+  jobs[1].method = Method::coarse_prolonged;
+  jobs[2].method = Method::progressive;  // with one level
+  try {
+    store.add_sweep("bad-method", "s.toml", jobs);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("job-0002: a progressive job solves 2 levels or more, not 1"),
+              std::string::npos)
+        << message;
+  }
+  EXPECT_TRUE(store.status().empty());
+  jobs.pop_back();
+  store.add_sweep("methods", "s.toml", jobs);
+  EXPECT_EQ(store.find_job("job-0000")->method, Method::direct);
+  EXPECT_EQ(store.find_job("job-0001")->method, Method::coarse_prolonged);
+}
+
 TEST(JobStoreSweeps, InvalidJobIsRefusedNamingSweepAndJobAndNothingIsAdded) {
   JobStore store(fresh_store_path());
   auto jobs = thickness_jobs(0, 3);

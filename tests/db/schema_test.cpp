@@ -101,13 +101,44 @@ constexpr const char* kVersionSixColumns =
     "ALTER TABLE levels DROP COLUMN outputs; ALTER TABLE sweeps DROP COLUMN refine; "
     "ALTER TABLE sweeps DROP COLUMN refine_pending; ";
 
-/// Drops what version 8 added (frames and probe readings), leaving what a version-7 store holds.
-constexpr const char* kVersionEightTables = "DROP TABLE frames; DROP TABLE probe_readings; ";
+/// Drops what version 9 added (each job's method), leaving what a version-8 store holds.
+constexpr const char* kVersionNineColumns = "ALTER TABLE jobs DROP COLUMN method; ";
+
+/// Drops what versions 9 and 8 added (frames and probe readings), leaving what a version-7
+/// store holds.
+const std::string kVersionEightTables =
+    std::string(kVersionNineColumns) + "DROP TABLE frames; DROP TABLE probe_readings; ";
+
+TEST(JobStoreSchema, AVersionEightStoreGainsTheMethodItsJobsDepthsImplied) {
+  const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
+  {
+    JobStore store(path);
+    std::vector<NewJob> jobs = test::thickness_jobs(0, 1, 1);
+    jobs.push_back(test::thickness_jobs(1, 1, 3).front());
+    store.add_sweep("s", "s.toml", jobs);
+  }
+  {
+    SqliteConnection raw(path, 1000);
+    raw.execute(std::string(kVersionNineColumns) + "DELETE FROM schema_version WHERE version > 8");
+    ASSERT_EQ(schema_version(raw), 8);
+  }
+  JobStore upgraded(path);
+  const std::vector<JobResult> results = upgraded.results(JobSelection::all());
+  ASSERT_EQ(results.size(), 2u);
+  EXPECT_EQ(results[0].job.depth, 1);
+  EXPECT_EQ(results[0].job.method, Method::direct);
+  EXPECT_EQ(results[1].job.depth, 3);
+  EXPECT_EQ(results[1].job.method, Method::progressive);
+  SqliteConnection raw(path, 1000);
+  EXPECT_EQ(schema_version(raw), latest_schema_version());
+  // A name that is not a method is refused by the table itself.
+  EXPECT_THROW(raw.execute("UPDATE jobs SET method = 'fast'"), DatabaseError);
+}
 
 /// Drops what versions 8 and 7 added (the hierarchy cache uses), leaving what a version-6 store
 /// holds.
 const std::string kVersionSevenTables =
-    std::string(kVersionEightTables) + "DROP TABLE hierarchy_cache_uses; ";
+    kVersionEightTables + "DROP TABLE hierarchy_cache_uses; ";
 
 TEST(JobStoreSchema, AVersionSevenStoreGainsFramesWithProbeReadingsKeepingItsLevels) {
   const auto path = psq::test::fresh_temp_dir("db-schema") / "psq.db";
@@ -122,7 +153,7 @@ TEST(JobStoreSchema, AVersionSevenStoreGainsFramesWithProbeReadingsKeepingItsLev
   }
   {
     SqliteConnection raw(path, 1000);
-    raw.execute(std::string(kVersionEightTables) + "DELETE FROM schema_version WHERE version > 7");
+    raw.execute(kVersionEightTables + "DELETE FROM schema_version WHERE version > 7");
     ASSERT_EQ(schema_version(raw), 7);
     ASSERT_EQ(single_integer(raw, "SELECT COUNT(*) FROM sqlite_schema WHERE name IN ('frames', "
                                   "'probe_readings')"),

@@ -30,6 +30,7 @@ inline std::vector<NewJob> thickness_jobs(int first, int count, int depth = 3,
                     {{"thickness", 1e-3 * (i + 1)}, {"E", 1e6}, {"depth", depth}},
                     "jobs/scenes/sheet.toml",
                     depth,
+                    method_of_depth(depth),
                     max_attempts,
                     std::nullopt});
   return jobs;

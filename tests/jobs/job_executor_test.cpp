@@ -39,6 +39,7 @@ class ScriptedSolver final : public jobs::LevelSolver {
     rest_.triangles = Triangles{{0, 1, 2}};
     x_ = flat(rest_.vertices);
     previous_ = x_;
+    finest_rest = rest_.vertices;
   }
 
   int level_count() const override { return levels_; }
@@ -88,7 +89,8 @@ class ScriptedSolver final : public jobs::LevelSolver {
   std::vector<PartRange> level_parts() const override {
     return {{"triangle", PartKind::shell, 0, 3, 0, 1}};
   }
-  Positions finest_positions() const override { return as_positions(x_); }
+  Positions finest_positions() const override { return as_positions(prolongation * x_); }
+  const Positions& finest_rest_positions() const override { return finest_rest; }
   /// The last frame of each level settles, as a progressive solve's refine frame does.
   bool settles_frame(int frame) const override { return frame == frames_; }
   std::map<std::string, double> state() const override { return {{"drift", drift_}}; }
@@ -106,6 +108,9 @@ class ScriptedSolver final : public jobs::LevelSolver {
 
   int fail_at_level = -1, fail_at_frame = -1;  ///< the frame that does not converge
   std::string failure;                          ///< the reason it gives, if any
+  /// The "finest mesh" of a coarse-prolonged solve: positions scaled, a rest shape of its own.
+  double prolongation = 1.0;
+  Positions finest_rest;
 
  private:
   int levels_, frames_, iterations_;
@@ -114,6 +119,13 @@ class ScriptedSolver final : public jobs::LevelSolver {
   TriMesh rest_;
   Eigen::VectorXd x_, previous_;
 };
+
+/// max_i ‖a_i − b_i‖, computed here rather than by the executor's own code.
+double largest_displacement(const Positions& a, const Positions& b) {
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) largest = std::max(largest, (a.row(i) - b.row(i)).norm());
+  return largest;
+}
 
 constexpr int kFrames = 4;
 constexpr int kIterations = 5;
@@ -143,11 +155,15 @@ class Workspace {
     };
     jobs::JobExecutor executor(
         store, dir_ / "psq.db", runs.empty() ? dir_ / "runs" : runs,
-        [this](const Scene&, int depth) {
+        [this](const Scene&, db::Method, int depth) {
           auto solver = std::make_unique<ScriptedSolver>(depth, kFrames, kIterations);
           solver->fail_at_level = fail_at_level;
           solver->fail_at_frame = fail_at_frame;
           solver->failure = failure;
+          if (finest_rest_shift != 0.0) {
+            solver->prolongation = 3.0;
+            solver->finest_rest.array() += finest_rest_shift;
+          }
           return solver;
         },
         {.snapshot_iterations = 2, .snapshot_seconds = 1e9, .code_version = "test"}, events, stop);
@@ -167,6 +183,8 @@ class Workspace {
   int fail_at_level = -1, fail_at_frame = -1;
   std::string failure;
   double lease_seconds = 30.0;
+  /// Not 0: the solver's finest positions are 3 x and its finest rest shape is shifted by this.
+  double finest_rest_shift = 0.0;
 
  private:
   fs::path dir_;
@@ -271,6 +289,24 @@ TEST_F(Executor, RunsEveryLevelAndRecordsItsCheckpoint) {
     }
   }
   EXPECT_EQ(r.levels[1].frames.back().probes.at(0).value[0], c.positions(0, 0));
+}
+
+TEST_F(Executor, TheAnswersDisplacementIsMeasuredOnTheFinestMeshAndAPreviewsOnItsOwn) {
+  // As for a coarse-prolonged job: the last level's state lives on a mesh of its own, its
+  // answer is its prolongation.
+  finest_rest_shift = 0.5;
+  ASSERT_EQ(run(), jobs::RunOutcome::done);
+  const db::JobResult r = result();
+  ASSERT_EQ(r.levels.size(), 2u);
+  const Checkpoint preview = read_checkpoint(run_dir().level_checkpoint(0));
+  const Checkpoint answer = final_checkpoint();
+  const Positions finest_rest = answer.rest_positions.array() + 0.5;
+  const double on_finest = largest_displacement(answer.finest_positions, finest_rest);
+  const double on_own = largest_displacement(answer.positions, answer.rest_positions);
+  EXPECT_GT(std::abs(on_finest - on_own), 1e-3 * on_finest);  // the two measures differ here
+  EXPECT_DOUBLE_EQ(r.levels[1].outputs.at("max_displacement"), on_finest);
+  EXPECT_DOUBLE_EQ(r.levels[0].outputs.at("max_displacement"),
+                   largest_displacement(preview.positions, preview.rest_positions));
 }
 
 TEST_F(Executor, StopWritesASnapshotReleasesAndResumesToTheSameResult) {
@@ -448,7 +484,7 @@ TEST(ExecutorScenes, TheResolutionSweepsJobsRunOnMeshesOfTheirEdgeLengths) {
   const std::atomic<bool> stop{false};
   jobs::JobExecutor executor(
       store, dir / "psq.db", dir / "runs",
-      [&](const Scene& scene, int depth) {
+      [&](const Scene& scene, db::Method, int depth) {
         vertices = build_shell_mesh(scene.shells.at(0).mesh).vertex_count();
         return std::make_unique<ScriptedSolver>(depth, 1, 1);
       },

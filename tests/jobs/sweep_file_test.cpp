@@ -106,6 +106,62 @@ TEST(SweepFile, DepthCanBeVaried) {
   EXPECT_TRUE(sweep.jobs[2].overrides.empty());
 }
 
+TEST(SweepFile, MethodsAreAnAxisWithDepthAndADirectJobIsListedOnce) {
+  const auto dir = sweep_dir();
+  const auto sweep = read_sweep(write_sweep(
+      dir, "[grid]\ndepth = [2, 3]\nmethod = [\"direct\", \"progressive\", \"coarse_prolonged\"]\n"));
+  // depth 2: direct, progressive, coarse; depth 3: (direct again, the same job), progressive,
+  // coarse.
+  ASSERT_EQ(sweep.jobs.size(), 5u);
+  const std::vector<std::pair<db::Method, int>> expected{{db::Method::direct, 1},
+                                                         {db::Method::progressive, 2},
+                                                         {db::Method::coarse_prolonged, 2},
+                                                         {db::Method::progressive, 3},
+                                                         {db::Method::coarse_prolonged, 3}};
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(sweep.jobs[k].method, expected[k].first) << k;
+    EXPECT_EQ(sweep.jobs[k].depth, expected[k].second) << k;
+  }
+  // Direct and progressive jobs keep the ids the same depths had before methods existed.
+  const auto by_depth = read_sweep(write_sweep(dir, "[grid]\ndepth = [1, 2, 3]\n"));
+  EXPECT_EQ(sweep.jobs[0].id, by_depth.jobs[0].id);
+  EXPECT_EQ(sweep.jobs[1].id, by_depth.jobs[1].id);
+  EXPECT_EQ(sweep.jobs[3].id, by_depth.jobs[2].id);
+  EXPECT_FALSE(sweep.jobs[1].parameters.contains("method"));
+  // A coarse-prolonged job is another job than the progressive one of its depth, and solves one
+  // level.
+  EXPECT_EQ(sweep.jobs[2].parameters.at("method"), "coarse_prolonged");
+  EXPECT_NE(sweep.jobs[2].id, sweep.jobs[1].id);
+  const std::vector<db::NewJob> stored = new_jobs(sweep);
+  EXPECT_EQ(stored[2].depth, 1);
+  EXPECT_EQ(stored[2].method, db::Method::coarse_prolonged);
+  EXPECT_EQ(stored[3].depth, 3);
+  EXPECT_EQ(describe_parameters(sweep.jobs[4]), "depth=3 method=coarse_prolonged");
+}
+
+TEST(SweepFile, TheMethodsSweepComparesFourMethodsAtTwoDepthsInSixJobs) {
+  const auto sweep = read_sweep(test::source_dir() / "jobs/sweeps/methods.toml");
+  std::vector<std::string> methods;  // each job's description up to its overrides
+  for (const auto& job : sweep.jobs) {
+    const std::string text = describe_parameters(job);
+    methods.push_back(text.substr(0, text.find(" shell.")));
+  }
+  EXPECT_EQ(methods, (std::vector<std::string>{
+                         "depth=1 method=direct", "depth=1 method=direct_final",
+                         "depth=2 method=progressive", "depth=2 method=coarse_prolonged",
+                         "depth=3 method=progressive", "depth=3 method=coarse_prolonged"}));
+}
+
+TEST(SweepFile, ATopLevelMethodAppliesToEveryJob) {
+  const auto sweep = read_sweep(write_sweep(
+      sweep_dir(), "method = \"coarse_prolonged\"\ndepth = 3\n[grid]\n\"" + kH + "\" = [1e-3, 2e-3]\n"));
+  ASSERT_EQ(sweep.jobs.size(), 2u);
+  for (const auto& job : sweep.jobs) {
+    EXPECT_EQ(job.method, db::Method::coarse_prolonged);
+    EXPECT_EQ(job.parameters.at("depth"), 3);
+  }
+}
+
 TEST(SweepFile, IdsAreStableUnderKeyOrderSyntaxAndNumberFormatting) {
   const auto dir = sweep_dir();
   const auto quoted = read_sweep(write_sweep(
@@ -236,6 +292,23 @@ INSTANTIATE_TEST_SUITE_P(
         BadSweep{"[grid]\n\"" + kE + "\" = [5e5, 500000]\n", "have the same parameters", 0},
         BadSweep{"depth = 1\n[grid]\ndepth = [2]\n", "given at the top level and varied", 3},
         BadSweep{"grids = 1\n", "did you mean 'grid'", 3},
+        BadSweep{"[grid]\nmethod = [\"direct\",\n  \"progresive\"]\n",
+                 "job depth=1 method=\"progresive\": 'method' must name a method, did you mean "
+                 "\"progressive\"? (got \"progresive\"); valid methods: direct, direct_final, "
+                 "progressive, coarse_prolonged",
+                 5},
+        BadSweep{"method = 2\n", "'method' must name a method (got 2); valid methods: direct", 3},
+        BadSweep{"depth = 2\nmethod = \"Direct\"\n",
+                 "'method' must name a method, did you mean \"direct\"? (got \"Direct\"); valid "
+                 "methods: direct, direct_final, progressive, coarse_prolonged",
+                 4},
+        BadSweep{"method = \"progressive\"\n",
+                 "method \"progressive\" solves a hierarchy, which needs 'depth' 2 or more (got 1)",
+                 3},
+        BadSweep{"[grid]\ndepth = [1]\nmethod = [\"coarse_prolonged\"]\n",
+                 "method \"coarse_prolonged\" solves a hierarchy", 5},
+        BadSweep{"method = \"direct\"\n[grid]\nmethod = [\"direct\"]\n",
+                 "'method' is given at the top level and varied", 3},
         BadSweep{"[grid\n", "TOML syntax error", 3}));
 
 TEST(SweepFile, MissingSceneAndMissingNameAreRefused) {
@@ -407,7 +480,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "needs two different outputs", 4},
         BadSweep{"depth = 3\nrefine = { rule = \"changed\", by = \"seconds\" }\n",
                  "needs 'count' (how many points) or 'above'", 4},
-        BadSweep{"refine = \"none\"\n", "has depth 1 and 0 preview levels; give the sweep depth 2",
+        BadSweep{"refine = \"none\"\n", "solves 1 level and has 0 preview levels; give the sweep depth 2",
                  3},
         BadSweep{"depth = 3\n[refine]\nrule = \"none\"\npreview = 3\n",
                  "lower 'preview' below the depth", 6},

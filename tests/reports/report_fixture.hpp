@@ -271,7 +271,8 @@ inline std::filesystem::path make_report_fixture(const std::filesystem::path& di
   const std::vector<FixtureJob> jobs = fixture_jobs();
   std::vector<db::NewJob> new_jobs;
   for (const FixtureJob& job : jobs)
-    new_jobs.push_back({job.id, job.parameters(), "plates.toml", job.depth(), 1});
+    new_jobs.push_back(
+        {job.id, job.parameters(), "plates.toml", job.depth(), db::method_of_depth(job.depth()), 1});
   store.add_sweep("plates", "sweeps/plates.toml", new_jobs);
   for (const FixtureJob& job : jobs) {
     if (job.state == db::JobState::queued) continue;

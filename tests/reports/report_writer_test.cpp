@@ -298,7 +298,8 @@ TEST_F(ReportWriter, EverySweepGoesToItsOwnDirectoryWithAnIndex) {
     db::JobStore store(database_);
     store.add_sweep(
         "plates again/2", "other.toml",
-        {{"00000000000000a1", test::fixture_jobs()[0].parameters(), "plates.toml", 3, 1}});
+        {{"00000000000000a1", test::fixture_jobs()[0].parameters(), "plates.toml", 3,
+          db::Method::progressive, 1}});
   }
   const auto out = dir_ / "all";
   const ReportOutcome outcome = write_report({database_, std::nullopt, out, "gnuplot"});

@@ -37,7 +37,7 @@ TEST_F(ResultsCommand, CsvHasOneRowPerJobLevelWithItsParameters) {
   std::string header, row;
   std::getline(lines, header);
   EXPECT_EQ(header,
-            "job,state,depth,shell.strip.material.thickness,time.frames,level,level_status,"
+            "job,state,depth,method,shell.strip.material.thickness,time.frames,level,level_status,"
             "iterations,final_residual,static_residual,wall_seconds,checkpoint,error");
   int rows = 0;
   for (; std::getline(lines, row); ++rows) {

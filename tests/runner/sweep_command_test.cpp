@@ -42,7 +42,7 @@ TEST_F(SweepCommand, AddsNewJobsOnceAndStatusCountsThem) {
   ASSERT_EQ(first.exit_code, 0) << first.errors;
   EXPECT_NE(first.output.find("sweep 's' (4 jobs): 4 added, 0 already present"), std::string::npos)
       << first.output;
-  EXPECT_NE(first.output.find("depth=1 time.frames=3 time.step=0.2"), std::string::npos)
+  EXPECT_NE(first.output.find("depth=1 method=direct time.frames=3 time.step=0.2"), std::string::npos)
       << first.output;
   auto second = psq({"sweep", "add", file});
   ASSERT_EQ(second.exit_code, 0) << second.errors;
