@@ -60,23 +60,30 @@ class PsqChild {
   }
 
   pid_t pid() const { return pid_; }
-  void signal(int signal) const { ::kill(pid_, signal); }
+  /// Signals the child while it runs; nothing once it has exited (kill(-1) would signal every
+  /// process the user may signal).
+  void signal(int signal) const {
+    if (pid_ > 0) ::kill(pid_, signal);
+  }
 
   /// Waits for the exit; returns the exit code, or 128 + signal when killed.
   int wait() {
-    int status = 0;
-    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    if (pid_ > 0) {
+      int status = 0;
+      while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+      }
+      exited(status);
     }
-    pid_ = -1;
-    return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
+    return exit_code_;
   }
-  /// Waits until the child stops itself (SIGSTOP) or exits: true if it stopped.
+  /// Waits until the child stops (SIGSTOP) or exits: true if it stopped. After an exit,
+  /// wait() returns its code.
   bool wait_until_stopped() {
     int status = 0;
     while (::waitpid(pid_, &status, WUNTRACED) < 0 && errno == EINTR) {
     }
     if (WIFSTOPPED(status)) return true;
-    pid_ = -1;
+    exited(status);
     return false;
   }
 
@@ -89,8 +96,14 @@ class PsqChild {
     return {std::istreambuf_iterator<char>(in), {}};
   }
 
+  void exited(int status) {
+    pid_ = -1;
+    exit_code_ = WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
+  }
+
   std::filesystem::path out_, err_;
   pid_t pid_ = -1;
+  int exit_code_ = -1;  ///< once exited
 };
 
 }  // namespace psq::test

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -24,6 +25,7 @@
 #include <regex>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "db/job_store.hpp"
@@ -137,14 +139,47 @@ struct Deliveries {
   int ints = 0;   ///< by SIGINT (likewise)
 };
 
+/// Whether a death of the worker process `pid` now would stop its job at the retry bound: it
+/// holds a job (its lease names the process, "host:pid") whose deaths without progress leave
+/// no failure to spare.
+bool death_would_fail_its_job(const SoakSweep& sweep, pid_t pid) {
+  const std::string owner_suffix = fmt::format(":{}", pid);
+  for (const db::JobResult& r : sweep.results()) {
+    const db::Job& job = r.job;
+    if (job.state == db::JobState::running && job.lease_owner.ends_with(owner_suffix))
+      return job.failures + 1 >= job.max_attempts;
+  }
+  return false;
+}
+
+/// Freezes `worker` (SIGSTOP) at the first moment its death would be an interruption, not the
+/// end of its job; false if it ended by itself meanwhile. Frozen, it cannot claim a job or
+/// record a checkpoint between the look at the store and the signal that follows.
+///
+/// The random delays alone let a slow worker (a sanitizer makes one several times slower) die
+/// again and again before its first checkpoint, until the retry bound fails its job, as it
+/// rightly does with a crash loop (docs/job-store.md); the soak is about interruptions. A
+/// worker whose job is one death from the bound is therefore let go on until its job's next
+/// checkpoint forgives the deaths before it, or until it holds another job.
+bool freeze_where_death_is_an_interruption(const SoakSweep& sweep, test::PsqChild& worker) {
+  for (;;) {
+    worker.signal(SIGSTOP);
+    if (!worker.wait_until_stopped()) return false;
+    if (!death_would_fail_its_job(sweep, worker.pid())) return true;
+    worker.signal(SIGCONT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
 /// Keeps two `psq work` processes running on the sweep and ends one of them at random moments:
 /// `kills` times with SIGKILL, once with SIGTERM (a third of the way) and once with SIGINT (two
 /// thirds). Each ended process is replaced at once. Stops early if the sweep is settled; then
 /// lets the two processes end by themselves.
 ///
-/// The one ended is the older of the two: a process just started is still loading its job, so
-/// ending it again and again before its first snapshot would make its job a crash loop, which
-/// the retry bound rightly stops (docs/job-store.md). Each process lives through two intervals.
+/// The one ended is the older of the two: a process just started is still loading its job,
+/// and each process lives through two intervals. A death that would fail a job waits for its
+/// progress (freeze_where_death_is_an_interruption), so that the schedule is one of
+/// interruptions however slowly the workers run.
 Deliveries signal_at_random(SoakSweep& sweep, int kills, unsigned seed) {
   std::mt19937 random(seed);
   std::uniform_int_distribution<int> delay_ms(100, 600);
@@ -160,7 +195,10 @@ Deliveries signal_at_random(SoakSweep& sweep, int kills, unsigned seed) {
     const int signal = k == sigterm_at ? SIGTERM : k == sigint_at ? SIGINT : SIGKILL;
     auto& worker = workers[older];
     older = 1 - older;
-    worker->signal(signal);
+    if (freeze_where_death_is_an_interruption(sweep, *worker)) {
+      worker->signal(signal);
+      worker->signal(SIGCONT);  // SIGTERM and SIGINT wait for it; SIGKILL does not
+    }
     const int code = worker->wait();
     // 0: the process had ended by itself, the queue being empty for it.
     EXPECT_TRUE(code == 128 + signal || code == 0) << code << worker->errors();
