@@ -160,7 +160,7 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
     // The tolerance is a bound on the projected Newton step (IPC's measure): ∇²E can be stiffer
     // than its projection where bent hinges add curvature, and its shorter step would pass the
     // test with more force left unbalanced. So a short unprojected step is judged projected.
-    if (!record.projected && record.step_norm < settings.tolerance) {
+    if (!record.projected() && record.step_norm < settings.tolerance) {
       free_direction = search_direction(objective, x, dofs, free_gradient, false, record);
       record.step_norm = free_direction.lpNorm<Eigen::Infinity>() / settings.step_scale;
     }
@@ -198,7 +198,7 @@ NewtonResult NewtonSolver::minimize(Objective& objective, Eigen::VectorXd& x, co
   return result;
 }
 
-void NewtonSolver::assemble_hessian(Objective& objective, const Eigen::VectorXd& x,
+bool NewtonSolver::assemble_hessian(Objective& objective, const Eigen::VectorXd& x,
                                     const DofMap& dofs, bool project, NewtonIteration& record) {
   bool pattern_changed = false;
   {
@@ -212,6 +212,7 @@ void NewtonSolver::assemble_hessian(Objective& objective, const Eigen::VectorXd&
     ScopedTimer timer(record.times.factorization);
     cholmod_.analyze(assembler_.matrix());
   }
+  return pattern_changed;
 }
 
 Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen::VectorXd& x,
@@ -224,15 +225,15 @@ Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen
   record.direction = DirectionKind::newton;
   if (try_unprojected) {
     assemble_hessian(objective, x, dofs, false, record);
-    record.projected = false;
     record.kept_negative_curvature = 1.0;
     if (try_newton(assembler_.matrix(), 0.0, free_gradient, direction, record)) return direction;
     exact_ = assembler_.matrix();
   }
-  record.projected = true;
   record.kept_negative_curvature = 0.0;
-  assemble_hessian(objective, x, dofs, true, record);
-  if (try_unprojected && try_blends(free_gradient, direction, record)) return direction;
+  // The blends need ∇²E and P on one pattern, the one analyzed.
+  const bool pattern_changed = assemble_hessian(objective, x, dofs, true, record);
+  if (try_unprojected && !pattern_changed && try_blends(free_gradient, direction, record))
+    return direction;
   if (try_newton(assembler_.matrix(), 0.0, free_gradient, direction, record)) return direction;
 
   record.direction = DirectionKind::shifted_newton;
@@ -249,25 +250,16 @@ Eigen::VectorXd NewtonSolver::search_direction(Objective& objective, const Eigen
 
 bool NewtonSolver::try_blends(const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
                               NewtonIteration& record) {
-  const Eigen::SparseMatrix<double>& projected = assembler_.matrix();
-  const auto same_pattern = [&] {
-    const Eigen::Index nonzeros = projected.nonZeros();
-    const Eigen::Index columns = projected.cols();
-    return exact_.cols() == columns && exact_.nonZeros() == nonzeros &&
-           std::equal(projected.outerIndexPtr(), projected.outerIndexPtr() + columns + 1,
-                      exact_.outerIndexPtr()) &&
-           std::equal(projected.innerIndexPtr(), projected.innerIndexPtr() + nonzeros,
-                      exact_.innerIndexPtr());
+  const auto values = [](const Eigen::SparseMatrix<double>& m) {
+    return Eigen::Map<const Eigen::ArrayXd>(m.valuePtr(), m.nonZeros());
   };
-  if (!projected.isCompressed() || !exact_.isCompressed() || !same_pattern()) return false;
+  const Eigen::SparseMatrix<double>& projected = assembler_.matrix();
+  const Eigen::ArrayXd dropped_curvature = values(exact_) - values(projected);
   blended_ = projected;
+  Eigen::Map<Eigen::ArrayXd> blended(blended_.valuePtr(), blended_.nonZeros());
   for (double beta = kFirstBlend; beta >= kLastBlend; beta *= 0.5) {
-    Eigen::Map<Eigen::ArrayXd>(blended_.valuePtr(), blended_.nonZeros()) =
-        Eigen::Map<const Eigen::ArrayXd>(projected.valuePtr(), projected.nonZeros()) +
-        beta * (Eigen::Map<const Eigen::ArrayXd>(exact_.valuePtr(), exact_.nonZeros()) -
-                Eigen::Map<const Eigen::ArrayXd>(projected.valuePtr(), projected.nonZeros()));
+    blended = values(projected) + beta * dropped_curvature;
     if (try_newton(blended_, 0.0, free_gradient, direction, record)) {
-      record.projected = false;
       record.kept_negative_curvature = beta;
       return true;
     }

@@ -39,11 +39,11 @@ struct NewtonSettings {
   int max_cut_steps = 0;
   double cut_step = 0.1;  ///< the feasible step below which a step counts as cut
   /// Project-on-demand Newton (Longva et al. 2023, "Pitfalls of Projection"): each direction
-  /// is first solved with ∇²E itself (HessianBlocks::project = false), and only when that is
-  /// not positive definite with the element-wise PSD projection P, or rather with the first
-  /// of P + β(∇²E − P), β = ½, ¼, ⅛, that is: where a few elements make ∇²E indefinite, P
-  /// would drop the negative curvature of every element, and the blend keeps part of it
-  /// (twist_wrap: 1686 → 1334 iterations, docs/benchmarks.md). The projection overstates the
+  /// is first solved with ∇²E itself (HessianBlocks::project = false). Where that is not
+  /// positive definite, with the first positive definite P + β(∇²E − P), β = ½, ¼, ⅛, of it and
+  /// its element-wise PSD projection P, and only when none is with P: where a few elements
+  /// make ∇²E indefinite, P drops the negative curvature of every element, and the blend keeps
+  /// part of it. The projection overstates the
   /// curvature of compressed membranes, bent hinges and contact pairs, so projected Newton
   /// crawls through flat valleys in short steps (docs/benchmarks.md). Convergence is still
   /// judged on the projected step, so the tolerance means what it means without. Off by
@@ -115,16 +115,16 @@ class NewtonSolver {
                                    const DofMap& dofs, const Eigen::VectorXd& free_gradient,
                                    bool try_unprojected, NewtonIteration& record);
   /// Asks the objective for its Hessian (projected or not), assembles it over the free DOFs
-  /// and analyzes its pattern when that changed.
-  void assemble_hessian(Objective& objective, const Eigen::VectorXd& x, const DofMap& dofs,
+  /// and analyzes its pattern when that changed; returns whether it did.
+  bool assemble_hessian(Objective& objective, const Eigen::VectorXd& x, const DofMap& dofs,
                         bool project, NewtonIteration& record);
   /// Factorizes K + shift·I and solves for d; false when that matrix is not positive definite
   /// or d is not a descent direction (gᵀd ≥ 0).
   bool try_newton(const Eigen::SparseMatrix<double>& K, double shift,
                   const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
                   NewtonIteration& record);
-  /// With ∇²E in exact_ and P in the assembler: d from the first positive definite
-  /// P + β(∇²E − P), β = ½, ¼, ⅛; false when none is (or the patterns differ).
+  /// With ∇²E in exact_ and P in the assembler, on one pattern: d from the first positive
+  /// definite P + β(∇²E − P), β = ½, ¼, ⅛; false when none is.
   bool try_blends(const Eigen::VectorXd& free_gradient, Eigen::VectorXd& direction,
                   NewtonIteration& record);
   /// Backtracking Armijo line search from α = min(1, max_feasible_step); moves x to the

@@ -47,12 +47,12 @@ struct NewtonIteration {
   DirectionKind direction = DirectionKind::newton;
   double shift = 0.0;            ///< σ when direction == shifted_newton
   bool pattern_changed = false;  ///< the sparsity pattern changed, so it was re-analyzed
-  /// d came from the element-wise PSD-projected Hessian P (false: from ∇²E itself, or from a
-  /// blend of the two, which was positive definite; NewtonSettings::project_on_demand).
-  bool projected = true;
-  /// β of the matrix P + β(∇²E − P) that gave d: 1 for ∇²E itself, 0 for the projection P,
-  /// ½, ¼ or ⅛ where ∇²E was indefinite but keeping that share of its negative curvature was not.
+  /// β of the matrix P + β(∇²E − P) that gave d: 1 for ∇²E itself, 0 for the element-wise
+  /// PSD projection P, ½, ¼ or ⅛ where ∇²E was indefinite but keeping that share of its negative
+  /// curvature was not (NewtonSettings::project_on_demand).
   double kept_negative_curvature = 0.0;
+  /// d came from P alone, none of ∇²E's negative curvature kept.
+  [[nodiscard]] bool projected() const { return kept_negative_curvature == 0.0; }
   /// The line search found no decrease of E, and the step's predicted decrease was below the
   /// rounding of E: no step was taken, and the solve stagnated at round-off.
   bool below_energy_rounding = false;
