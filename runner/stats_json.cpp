@@ -61,6 +61,7 @@ nlohmann::json frame_json(const FrameRecord& r) {
           {"step_norm_history", step_norms},
           {"gradient_norm_history", gradient_norms},
           {"settle_steps", r.settle_steps},
+          {"predicted", r.predicted},
           {"static_residual", std::isnan(r.static_residual) ? nlohmann::json(nullptr)
                                                             : nlohmann::json(r.static_residual)},
           {"friction_iterations", r.friction_iterations},

@@ -155,6 +155,19 @@ void FrameSolver::begin_frame(Eigen::VectorXd& x, FrameRecord& record,
   potential_.remove_term(pull_);
 }
 
+bool FrameSolver::predict(Eigen::VectorXd& x, const Eigen::VectorXd& motion) {
+  Eigen::VectorXd move = motion;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    if (dofs_.reduced(i) < 0) move[i] = 0.0;
+  if (move.isZero(0.0)) return false;
+  const double step = potential_.max_feasible_step(x, move);
+  if (step <= 0.0) return false;
+  Eigen::VectorXd predicted = x + step * move;
+  if (!std::isfinite(potential_.value(predicted))) return false;
+  x = std::move(predicted);
+  return true;
+}
+
 bool FrameSolver::move_scripted_vertices_if_safe(Eigen::VectorXd& x, double time) {
   Eigen::VectorXd target = x;
   system_.apply_pins(target, time);

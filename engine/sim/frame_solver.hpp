@@ -5,11 +5,12 @@
 // each level of a progressive solve steps its own meshes with it, over the level's proxy
 // elastics.
 //
-// A frame's step begins (begin_frame) by moving the scripted vertices to their targets: with
-// contact, κ is chosen first (IPC), then they move directly when the CCD finds that move safe;
-// otherwise they are freed and pulled toward the targets by a penalty of growing stiffness
-// (KinematicPull) while the CCD line search keeps every iterate intersection-free, and they are
-// pinned at the targets as soon as the rest of the way is safe. The step's solve (solve_held)
+// A frame's step starts from the last answer moved on by the last frame's motion, as far as
+// that is safe (predict), then begins (begin_frame) by moving the scripted vertices to their
+// targets: with contact, κ is chosen first (IPC), then they move directly when the CCD finds
+// that move safe; otherwise they are freed and pulled toward the targets by a penalty of
+// growing stiffness (KinematicPull) while the CCD line search keeps every iterate
+// intersection-free, and they are pinned at the targets as soon as the rest of the way is safe. The step's solve (solve_held)
 // follows with them fixed: Newton in chunks with κ and κ_s adapted between chunks, inside IPC's
 // outer friction loop when the scene has friction. With strain limits, the line search starts
 // from the barrier's feasible step, so no accepted iterate stretches a triangle to its limit.
@@ -41,6 +42,9 @@ struct FrameRecord {
   NewtonResult newton;
   /// Settling steps after the frame's step (0 with frame_solution = fixed_step).
   int settle_steps = 0;
+  /// Whether Newton started from the last answer moved on by the last frame's motion
+  /// (FrameSolver::predict) rather than from the last answer.
+  bool predicted = false;
   /// ‖d‖∞/Δt of the Newton step of the last settling step (Δt·4⁶, a nearly inertia-free step) at
   /// the frame's answer: its distance to the static equilibrium, in the tolerance's measure. NaN
   /// when the frame was not settled (fixed_step, or its step or settling did not converge).
@@ -98,6 +102,13 @@ class FrameSolver {
   /// pull rounds are appended to record). Resets the contact statistics.
   void begin_frame(Eigen::VectorXd& x, FrameRecord& record, const NewtonSettings& settings,
                    const NewtonSolver::Progress& progress);
+  /// Moves x's free DOFs on by `motion` (the last frame's motion), or by the largest fraction
+  /// of it the CCD finds intersection-free, when the potential stays finite there; returns
+  /// whether it moved. Newton's start only, the frame's objective is unchanged: a shell that
+  /// keeps moving as it did (a cloth twisting on, a cloth falling) starts near its answer
+  /// instead of a frame's motion behind it. Call before begin_frame, which then moves the
+  /// scripted vertices from there.
+  bool predict(Eigen::VectorXd& x, const Eigen::VectorXd& motion);
   /// One solve from x with the pinned vertices where they are, appended to record.newton. The
   /// caller has set the potential's xᵗ; friction is lagged at `previous` (xᵗ) and its slip
   /// measured from `frame_start`.

@@ -91,7 +91,12 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   system_.set_load_time(record.time);
   const int resumed_iterations = std::exchange(resumed_iterations_, 0);
   const bool resumed_in_settling = resumed_iterations > 0 && settle_growth_ > 0;
-  if (resumed_iterations == 0) previous_ = x_;
+  // A fixed-step frame starts from the last frame's answer moved on by that frame's motion; a
+  // settled frame's last step barely moved, so its prediction is nil. The motion is x − xᵗ,
+  // which a snapshot between frames holds, so a resumed run predicts as the uninterrupted one.
+  const bool fresh_frame = resumed_iterations == 0;
+  const Eigen::VectorXd last_motion = fresh_frame ? Eigen::VectorXd(x_ - previous_) : Eigen::VectorXd();
+  if (fresh_frame) previous_ = x_;
   frame_start_ = previous_;
   potential_.set_previous(previous_);
   const int frame_number = record.frame;
@@ -104,6 +109,7 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
       numbered_through_frame(frame_progress, iterations_taken);
   // Newton iterates on x_ itself, so that positions() is the current iterate while it runs.
   if (!resumed_in_settling) {
+    if (fresh_frame) record.predicted = frame_solver_.predict(x_, last_motion);
     frame_solver_.begin_frame(x_, record, settings, counted_progress);
     frame_solver_.solve_held(x_, previous_, frame_start_, record, settings, counted_progress);
     // The frame's step was the settling schedule's first, at Δt.

@@ -1,6 +1,7 @@
 // Contact in the quasistatic simulation: no accepted Newton iterate intersects (head-on
-// collision, a collider driven into a pinned sheet), scripted motion reaches its targets, and
-// the contact surface pairs the bodies as documented.
+// collision, a collider driven into a pinned sheet), a frame's predicted start stays
+// intersection-free, scripted motion reaches its targets, and the contact surface pairs the
+// bodies as documented.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +9,9 @@
 
 #include "engine/contact/intersection_check.hpp"
 #include "engine/sim/contact_term.hpp"
+#include "engine/sim/frame_solver.hpp"
+#include "engine/sim/incremental_potential.hpp"
+#include "engine/sim/shell_system.hpp"
 #include "engine/sim/quasistatic.hpp"
 
 namespace psq {
@@ -79,6 +83,50 @@ TEST(ContactSimulation, HeadOnCollisionNeverAcceptsAnIntersectingState) {
     lowest = std::min(lowest, sim.positions()[3 * v + 2]);
   EXPECT_GT(lowest, 0.0);
   EXPECT_LT(lowest, 1e-3);
+}
+
+TEST(ContactSimulation, PredictionMovesTheFreeVerticesAsFarAsTheCcdAllows) {
+  const Scene scene = head_on_scene();
+  const ShellSystem system(scene);
+  IncrementalPotential potential(system, scene.time.step);
+  FrameSolver solver(system, potential);
+  const Eigen::VectorXd rest = flat(system.rest_mesh().vertices);
+  const ShellBlock& floor = system.shells()[0];
+  const ShellBlock& pad = system.shells()[1];
+  const auto pad_lowest = [&](const Eigen::VectorXd& x) {
+    double lowest = 1.0;
+    for (int v = pad.first_vertex; v < pad.first_vertex + pad.vertex_count; ++v)
+      lowest = std::min(lowest, x[3 * v + 2]);
+    return lowest;
+  };
+  // Every vertex asked to move, the pinned floor too: only the free pad may follow.
+  const auto shifted_by = [&](double dz) {
+    Eigen::VectorXd motion = Eigen::VectorXd::Zero(rest.size());
+    for (Eigen::Index i = 2; i < motion.size(); i += 3) motion[i] = dz;
+    return motion;
+  };
+
+  // Up, away from the floor: safe, so the whole motion.
+  Eigen::VectorXd x = rest;
+  ASSERT_TRUE(solver.predict(x, shifted_by(2e-3)));
+  EXPECT_NEAR(pad_lowest(x) - pad_lowest(rest), 2e-3, 1e-15);
+
+  // Down 1 cm onto a floor 5 mm below: cut short of the floor by the CCD.
+  x = rest;
+  ASSERT_TRUE(solver.predict(x, shifted_by(-1e-2)));
+  EXPECT_LT(pad_lowest(x), pad_lowest(rest) - 1e-3);
+  EXPECT_GT(pad_lowest(x), 0.0);
+  EXPECT_TRUE(
+      find_intersections(as_positions(x), system.rest_mesh().triangles).clean());
+  for (int v = floor.first_vertex; v < floor.first_vertex + floor.vertex_count; ++v)
+    EXPECT_EQ(x.segment<3>(3 * v), rest.segment<3>(3 * v)) << "floor vertex " << v;
+
+  // Nothing free to move: no prediction.
+  x = rest;
+  Eigen::VectorXd floor_only = Eigen::VectorXd::Zero(rest.size());
+  floor_only.segment(3 * floor.first_vertex, 3 * floor.vertex_count).setConstant(1e-3);
+  EXPECT_FALSE(solver.predict(x, floor_only));
+  EXPECT_EQ(x, rest);
 }
 
 /// A sphere collider 5 mm above a sheet held at its rim, moving down 1 cm per frame.
