@@ -226,21 +226,9 @@ class OverlapSearch {
   std::atomic<bool> stopped_{false};
 };
 
-/// The pairs (i, j) of an OverlapSearch for which keep(i, j) returns a Pair, sorted. Pairs
-/// come from `a` and `b`, or from `a` alone when `b` is null.
-template <class Pair, class Keep>
-std::vector<Pair> sorted_pairs(const BoxTree& a, const BoxTree* b, double reach, const Keep& keep) {
-  tbb::enumerable_thread_specific<std::vector<Pair>> found;
-  const auto visit = [&](int i, int j) {
-    if (const std::optional<Pair> pair = keep(i, j)) found.local().push_back(*pair);
-    return true;
-  };
-  OverlapSearch search(a, b ? *b : a, reach, visit);
-  if (b) {
-    search.between();
-  } else {
-    search.within();
-  }
+/// Every thread's pairs of `found` in one sorted list.
+template <class Pair>
+std::vector<Pair> gathered_sorted(tbb::enumerable_thread_specific<std::vector<Pair>>& found) {
   std::size_t total = 0;
   for (const auto& part : found) total += part.size();
   std::vector<Pair> out;
@@ -248,14 +236,6 @@ std::vector<Pair> sorted_pairs(const BoxTree& a, const BoxTree* b, double reach,
   for (const auto& part : found) out.insert(out.end(), part.begin(), part.end());
   tbb::parallel_sort(out.begin(), out.end());
   return out;
-}
-
-/// Whether some pair of an OverlapSearch satisfies test(i, j); stops at the first.
-template <class Test>
-bool any_pair_of(const BoxTree& a, const BoxTree* b, double reach, const Test& test) {
-  const auto visit = [&](int i, int j) { return !test(i, j); };
-  OverlapSearch search(a, b ? *b : a, reach, visit);
-  return b ? !search.between() : !search.within();
 }
 
 void check_finite(const Positions& x, const char* name) {
@@ -341,6 +321,12 @@ BroadPhase::BroadPhase(Triangles triangles, std::vector<std::array<int, 2>> edge
     if (b < 0) throw std::invalid_argument(fmt::format("BroadPhase: negative body id {}", b));
     body_count_ = std::max(body_count_, b + 1);
   }
+  bodies_.resize(body_count_);
+  for (int v = 0; v < n; ++v) bodies_[vertex_body_[v]].vertices.push_back(v);
+  for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
+    bodies_[vertex_body_[edges_[e][0]]].edges.push_back(e);
+  for (int t = 0; t < triangles_.rows(); ++t)
+    bodies_[vertex_body_[triangles_(t, 0)]].triangles.push_back(t);
   body_pair_allowed_.assign(std::size_t(body_count_) * body_count_, 1);
   if (!may_touch) return;
   for (int a = 0; a < body_count_; ++a)
@@ -366,43 +352,90 @@ bool BroadPhase::is_edge_edge_pair(int e, int f) const {
   return !shares_vertex(edges_[e], edges_[f]) && bodies_may_touch(edges_[e][0], edges_[f][0]);
 }
 
-/// The three trees of one query, built side by side.
+/// The vertex, edge and triangle trees of each body for one query, built side by side.
 struct BroadPhase::Trees {
-  std::optional<BoxTree> vertex, edge, triangle;
+  std::vector<BoxTree> vertex, edge, triangle;
 
-  explicit Trees(const ElementBoxes& boxes) {
-    tbb::parallel_invoke([&] { vertex.emplace(boxes.vertex); }, [&] { edge.emplace(boxes.edge); },
-                         [&] { triangle.emplace(boxes.triangle); });
+  Trees(const ElementBoxes& boxes, const std::vector<BodyElements>& bodies) {
+    const auto subset = [](const std::vector<Box>& all, const std::vector<int>& ids) {
+      std::vector<Box> part(ids.size());
+      for (std::size_t k = 0; k < ids.size(); ++k) part[k] = all[ids[k]];
+      return part;
+    };
+    const int body_count = static_cast<int>(bodies.size());
+    std::vector<std::optional<BoxTree>> built(3 * std::size_t(body_count));
+    tbb::parallel_for(0, 3 * body_count, [&](int task) {
+      const BodyElements& body = bodies[task / 3];
+      switch (task % 3) {
+        case 0: built[task].emplace(subset(boxes.vertex, body.vertices)); break;
+        case 1: built[task].emplace(subset(boxes.edge, body.edges)); break;
+        default: built[task].emplace(subset(boxes.triangle, body.triangles)); break;
+      }
+    });
+    for (int b = 0; b < body_count; ++b) {
+      vertex.push_back(std::move(*built[3 * b]));
+      edge.push_back(std::move(*built[3 * b + 1]));
+      triangle.push_back(std::move(*built[3 * b + 2]));
+    }
   }
 };
 
+template <class Visit>
+bool BroadPhase::search_point_triangle(const Trees& trees, double reach,
+                                       const Visit& visit) const {
+  for (int a = 0; a < body_count_; ++a)
+    for (int b = 0; b < body_count_; ++b) {
+      if (!body_pair_allowed_[a * body_count_ + b]) continue;
+      const std::vector<int>& vertices = bodies_[a].vertices;
+      const std::vector<int>& triangles = bodies_[b].triangles;
+      const auto in_surface = [&](int v, int t) { return visit(vertices[v], triangles[t]); };
+      OverlapSearch search(trees.vertex[a], trees.triangle[b], reach, in_surface);
+      if (!search.between()) return false;
+    }
+  return true;
+}
+
+template <class Visit>
+bool BroadPhase::search_edge_edge(const Trees& trees, double reach, const Visit& visit) const {
+  for (int a = 0; a < body_count_; ++a)
+    for (int b = a; b < body_count_; ++b) {
+      if (!body_pair_allowed_[a * body_count_ + b]) continue;
+      const std::vector<int>& first = bodies_[a].edges;
+      const std::vector<int>& second = bodies_[b].edges;
+      const auto in_surface = [&](int e, int f) { return visit(first[e], second[f]); };
+      OverlapSearch search(trees.edge[a], trees.edge[b], reach, in_surface);
+      if (!(a == b ? search.within() : search.between())) return false;
+    }
+  return true;
+}
+
 ContactCandidates BroadPhase::candidates(const ElementBoxes& boxes, double reach) const {
-  const Trees trees(boxes);
-  ContactCandidates out;
-  out.point_triangle = sorted_pairs<PointTriangleCandidate>(
-      *trees.vertex, &*trees.triangle, reach,
-      [&](int v, int t) -> std::optional<PointTriangleCandidate> {
-        if (!is_point_triangle_pair(v, t)) return std::nullopt;
-        return PointTriangleCandidate{v, t};
-      });
-  out.edge_edge = sorted_pairs<EdgeEdgeCandidate>(
-      *trees.edge, nullptr, reach, [&](int e, int f) -> std::optional<EdgeEdgeCandidate> {
-        if (!is_edge_edge_pair(e, f)) return std::nullopt;
-        return EdgeEdgeCandidate{std::min(e, f), std::max(e, f)};
-      });
-  return out;
+  const Trees trees(boxes, bodies_);
+  tbb::enumerable_thread_specific<std::vector<PointTriangleCandidate>> point_triangle;
+  tbb::enumerable_thread_specific<std::vector<EdgeEdgeCandidate>> edge_edge;
+  search_point_triangle(trees, reach, [&](int v, int t) {
+    if (is_point_triangle_pair(v, t)) point_triangle.local().push_back({v, t});
+    return true;
+  });
+  search_edge_edge(trees, reach, [&](int e, int f) {
+    if (is_edge_edge_pair(e, f)) edge_edge.local().push_back({std::min(e, f), std::max(e, f)});
+    return true;
+  });
+  return {gathered_sorted(point_triangle), gathered_sorted(edge_edge)};
 }
 
 /// `near` has point_triangle(v, t) and edge_edge(e, f), the exact tests of a box candidate.
 template <class Near>
 bool BroadPhase::any_pair(const ElementBoxes& boxes, double reach, const Near& near) const {
-  const Trees trees(boxes);
-  return any_pair_of(*trees.vertex, &*trees.triangle, reach,
-                     [&](int v, int t) {
-                       return is_point_triangle_pair(v, t) && near.point_triangle(v, t);
-                     }) ||
-         any_pair_of(*trees.edge, nullptr, reach,
-                     [&](int e, int f) { return is_edge_edge_pair(e, f) && near.edge_edge(e, f); });
+  const Trees trees(boxes, bodies_);
+  return !search_point_triangle(trees, reach,
+                                [&](int v, int t) {
+                                  return !(is_point_triangle_pair(v, t) &&
+                                           near.point_triangle(v, t));
+                                }) ||
+         !search_edge_edge(trees, reach, [&](int e, int f) {
+           return !(is_edge_edge_pair(e, f) && near.edge_edge(e, f));
+         });
 }
 
 ContactCandidates BroadPhase::distance_candidates(const Positions& x, double reach) const {
@@ -506,9 +539,14 @@ std::vector<std::array<int, 2>> overlapping_triangle_boxes(const Positions& x,
     boxes[t].setEmpty();
     for (int k = 0; k < 3; ++k) boxes[t].extend(position(x, triangles(t, k)));
   });
-  return sorted_pairs<std::array<int, 2>>(BoxTree(boxes), nullptr, 0.0, [](int s, int t) {
-    return std::optional(std::array{std::min(s, t), std::max(s, t)});
-  });
+  tbb::enumerable_thread_specific<std::vector<std::array<int, 2>>> found;
+  const BoxTree tree(boxes);
+  const auto keep = [&](int s, int t) {
+    found.local().push_back({std::min(s, t), std::max(s, t)});
+    return true;
+  };
+  OverlapSearch(tree, tree, 0.0, keep).within();
+  return gathered_sorted(found);
 }
 
 }  // namespace psq

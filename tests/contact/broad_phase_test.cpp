@@ -261,6 +261,29 @@ TEST(BroadPhase, BodyPairRuleFiltersPairs) {
       [&](const auto& c) { return s.body[c.vertex] == 0 && body_of_triangle(c.triangle) == 0; }));
 }
 
+TEST(BroadPhase, BodiesThatTouchOnlyEachOtherGiveOnlyTheirCrossPairsInEveryQuery) {
+  std::mt19937 rng(29);
+  const Surface s = perturbed_sheets(rng);
+  const Positions x1 = randomly_moved(s.x, 0.01, rng);
+  // Two colliders, say: each body is searched only against the other.
+  const BodyPairRule only_across = [](int a, int b) { return a != b; };
+  const BroadPhase broad = broad_phase_of(s, only_across);
+  for (double reach : {0.002, 0.02}) {
+    SCOPED_TRACE(::testing::Message() << "reach " << reach);
+    const ContactCandidates found = broad.distance_candidates(s.x, reach);
+    EXPECT_FALSE(found.empty());
+    expect_same(found, brute_force(s, {&s.x}, reach, only_across));
+    expect_same(broad.swept_candidates(s.x, x1, reach),
+                brute_force(s, {&s.x, &x1}, reach, only_across));
+  }
+  const double closest = closest_pair_distance(s, s.x, only_across);
+  ASSERT_GT(closest, 0.0);
+  ASSERT_LT(closest, 1.0);
+  EXPECT_NEAR(broad.clearance(s.x, 0.0, 10 * closest), closest, 1e-9 * closest);
+  EXPECT_FALSE(broad.any_within_reach_during(s.x, s.x, 0.99 * closest));
+  EXPECT_TRUE(broad.any_within_reach_during(s.x, s.x, 1.01 * closest));
+}
+
 TEST(BroadPhase, NoPairSharesAVertexAndListsAreStrictlySorted) {
   std::mt19937 rng(13);
   const Surface s = perturbed_sheets(rng);
