@@ -430,7 +430,8 @@ class JobRun {
     return c;
   }
 
-  /// Writes a checkpoint, timed; a failure to write is the environment's, not the job's.
+  /// Writes a checkpoint, timed; a failure to write is the environment's, not the job's, while
+  /// a checkpoint refused as inconsistent (a non-finite state, say) is the job's failure.
   std::uint64_t write(const fs::path& file, const Checkpoint& c) {
     const Clock::time_point start = Clock::now();
     try {
@@ -440,7 +441,7 @@ class JobRun {
       since_checkpoint_ = Clock::now();
       iterations_since_checkpoint_ = 0;
       return checksum;
-    } catch (const CheckpointError& error) {
+    } catch (const CheckpointWriteError& error) {
       throw environment_failure(error.what());
     }
   }

@@ -313,7 +313,9 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
     fail(file_name, fmt::format("refusing to write an inconsistent checkpoint: {}", *problem));
   const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
   if (std::error_code error; !std::filesystem::is_directory(directory, error))
-    fail(file_name, fmt::format("cannot write checkpoint: no directory '{}'", directory.string()));
+    throw CheckpointWriteError(located_message(
+        file_name, 0,
+        fmt::format("cannot write checkpoint: no directory '{}'", directory.string())));
   try {
     std::uint64_t checksum = 0;
     replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
@@ -329,7 +331,8 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
     return checksum;
   } catch (const std::exception& e) {
     // HDF5 errors name the temporary file; the caller knows the checkpoint by its final name.
-    fail(file_name, fmt::format("cannot write checkpoint: {}", e.what()));
+    throw CheckpointWriteError(
+        located_message(file_name, 0, fmt::format("cannot write checkpoint: {}", e.what())));
   }
 }
 

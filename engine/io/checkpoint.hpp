@@ -27,6 +27,13 @@ class CheckpointError : public InputError {
   using InputError::InputError;
 };
 
+/// A consistent checkpoint that the file system would not take (no space, read-only, no
+/// permission, a missing directory): the environment's failure, not the checkpoint's.
+class CheckpointWriteError : public CheckpointError {
+ public:
+  using CheckpointError::CheckpointError;
+};
+
 /// Where in a level's work a checkpoint was taken: what a resuming solver does next.
 enum class LevelProgress {
   inside_frame,  ///< Newton is still iterating on `frame`: continue it from `positions`
@@ -107,8 +114,8 @@ inline constexpr std::string_view finest_positions = "/mesh/finest_positions";
 /// content (every attribute and dataset) inside the file. Returns the FNV-1a 64 checksum of the
 /// bytes of the written file, for the store to record. Throws CheckpointError naming `path` if
 /// the checkpoint is inconsistent (shapes, triangle indices, non-finite values, parameters that
-/// are not JSON) or cannot be written (the system's reason, e.g. "No space left on device");
-/// the previous file is then left as it was.
+/// are not JSON), and CheckpointWriteError if it cannot be written (the system's reason, e.g.
+/// "No space left on device"); the previous file is then left as it was.
 std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
 
 /// Reads and verifies a checkpoint: the file's checksum against `expected_file_checksum` when

@@ -255,6 +255,8 @@ TEST(Checkpoint, InconsistentCheckpointsAreNotWritten) {
     try {
       write_checkpoint(path, *bad);
       ADD_FAILURE() << "an inconsistent checkpoint was written";
+    } catch (const CheckpointWriteError& e) {
+      ADD_FAILURE() << "an inconsistent checkpoint is not a failure to write: " << e.what();
     } catch (const CheckpointError& e) {
       EXPECT_TRUE(contains(e.what(), path.string())) << e.what();
       EXPECT_TRUE(contains(e.what(), "inconsistent")) << e.what();
@@ -268,19 +270,20 @@ TEST(Checkpoint, MissingDirectoryIsNamed) {
   try {
     write_checkpoint(path, sample_checkpoint(3, 0, 1));
     FAIL() << "wrote into a missing directory";
-  } catch (const CheckpointError& e) {
+  } catch (const CheckpointWriteError& e) {
     EXPECT_TRUE(contains(e.what(), path.string())) << e.what();
     EXPECT_TRUE(contains(e.what(), "no directory")) << e.what();
   }
 }
 
 /// In a child process (gtest death test): runs `prepare`, then writes a checkpoint to `path`
-/// and exits 0 after printing the CheckpointError's message, 1 if the write succeeded.
+/// and exits 0 after printing the CheckpointWriteError's message; 1 if the write succeeded, and
+/// any other exception aborts.
 void write_in_child_expecting_failure(const fs::path& path, void (*prepare)()) {
   prepare();
   try {
     write_checkpoint(path, sample_checkpoint(20, 0, 2));
-  } catch (const CheckpointError& e) {
+  } catch (const CheckpointWriteError& e) {
     std::cerr << e.what() << std::endl;
     std::_Exit(0);
   }
@@ -345,7 +348,7 @@ TEST(Checkpoint, AFullDiskKeepsThePreviousCheckpointWhereverTheWriteRunsOutOfSpa
     try {
       write_checkpoint(path, next);
       ADD_FAILURE() << "the write succeeded on a full disk";
-    } catch (const CheckpointError& e) {
+    } catch (const CheckpointWriteError& e) {
       EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos)
           << e.what();
