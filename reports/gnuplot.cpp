@@ -30,6 +30,8 @@ const char* style_name(PlotSpec::Style style) {
       return "points pt 7 ps 0.8";
     case PlotSpec::Style::linespoints:
       return "linespoints lw 1.5 pt 7 ps 0.6";
+    case PlotSpec::Style::thick_lines:
+      return "lines lw 4 dt 2";
   }
   return "linespoints";
 }
@@ -78,7 +80,7 @@ std::string gnuplot_script(const PlotSpec& plot, const std::filesystem::path& ou
     script += fmt::format("$series{} << EOD\n{}EOD\n", s, block);
     const PlotSeries& series = plot.series[s];
     clauses.push_back(fmt::format(
-        "$series{} using 1:2 with {}{} {}", s, style_name(plot.style),
+        "$series{} using 1:2 with {}{} {}", s, style_name(series.style.value_or(plot.style)),
         series.colour.empty() ? "" : fmt::format(" lc rgb {}", quoted(series.colour)),
         series.title.empty() ? "notitle" : "title " + quoted(series.title)));
   }

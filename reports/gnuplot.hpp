@@ -2,25 +2,31 @@
 // Plots drawn by gnuplot (a child process running a script file) as SVG text.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace psq::reports {
 
+/// How a curve is drawn; `thick_lines` stands out over the others (a Pareto front over the
+/// points it selects).
+enum class PlotStyle { lines, points, linespoints, thick_lines };
+
 /// One curve: its legend title (empty: not in the legend) and its (x, y) points in drawing
 /// order; `colour` ("#rrggbb") overrides gnuplot's colour sequence, so that several curves can
-/// read as one group.
+/// read as one group; `style` overrides the plot's style for this curve.
 struct PlotSeries {
   std::string title;
   std::vector<std::pair<double, double>> points;
   std::string colour;
+  std::optional<PlotStyle> style = std::nullopt;
 };
 
 /// A 2D plot. On a logarithmic axis, points with a non-positive coordinate are left out;
 /// non-finite points are always left out.
 struct PlotSpec {
-  enum class Style { lines, points, linespoints };
+  using Style = PlotStyle;
   std::string title;
   std::string x_label;
   std::string y_label;
