@@ -154,11 +154,13 @@ void add_finest_results(const std::vector<std::optional<LevelCheckpoint>>& check
   if (const auto energy = finest.solver.scalars.find(kElasticEnergyScalar);
       energy != finest.solver.scalars.end())
     job.outputs.elastic_energy = energy->second;
+  // Against the answer on the finest mesh: a coarse-prolonged job's positions are its coarse
+  // mesh's.
   for (std::size_t l = 0; l < checkpoints.size(); ++l) {
     if (!checkpoints[l]) continue;
     try {
-      job.levels[l].error_to_finest =
-          relative_error_to_finest(checkpoints[l]->checkpoint.finest_positions, finest.positions);
+      job.levels[l].error_to_finest = relative_error_to_finest(
+          checkpoints[l]->checkpoint.finest_positions, finest.finest_positions);
     } catch (const std::invalid_argument& e) {
       job.problems.push_back(fmt::format("level {}: error to the finest level: {}", l, e.what()));
     }
@@ -216,9 +218,9 @@ std::map<std::string, Positions> reference_positions(const std::vector<db::JobRe
     const db::LevelRecord& record = result.levels.back();
     const std::filesystem::path file = resolve_checkpoint(record.checkpoint_path, database);
     try {
-      references.emplace(
-          design_point(result.job),
-          read_checkpoint(file, recorded_checksum(record.checkpoint_checksum, file)).positions);
+      references.emplace(design_point(result.job),
+                         read_checkpoint(file, recorded_checksum(record.checkpoint_checksum, file))
+                             .finest_positions);
     } catch (const InputError&) {
     }
   }

@@ -224,6 +224,35 @@ Table speedup_table(const SweepReport& report) {
   return table;
 }
 
+Table benchmark_table(const SweepReport& report) {
+  const std::vector<std::string> point_parameters = design_parameters(report);
+  Table table;
+  table.header = {"#", "id"};
+  table.header.insert(table.header.end(), point_parameters.begin(), point_parameters.end());
+  for (const char* column : {"method", "level", "time (s)", "error to direct_final",
+                             "speed-up over direct_final", "speed-up over direct", "Pareto front"})
+    table.header.push_back(column);
+  for (const BenchmarkScene& scene : benchmark_scenes(report))
+    for (const BenchmarkDesignPoint& design : scene.design_points) {
+      const JobReport* direct = baseline_of(report, *design.reference, db::Method::direct);
+      for (const BenchmarkPoint& point : design.points) {
+        const JobReport& job = *point.job;
+        std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
+        for (const std::string& name : point_parameters) row.push_back(parameter_cell(job, name));
+        row.insert(
+            row.end(),
+            {method_label(job.job), fmt::format("{} of {}", point.level, job.levels.size()),
+             readable_number(point.seconds), readable_number(point.error),
+             readable_number(speedup(design.reference->outputs.total_seconds, point.seconds)),
+             readable_number(
+                 speedup(direct ? direct->outputs.total_seconds : std::nullopt, point.seconds)),
+             point.on_front ? "yes" : ""});
+        table.rows.push_back(std::move(row));
+      }
+    }
+  return table;
+}
+
 std::string cache_summary_text(const HierarchyCacheSummary& cache) {
   if (cache.hits + cache.builds == 0)
     return "Hierarchy cache: not used (direct solves only, or no cache use recorded)";
