@@ -68,7 +68,8 @@ inline constexpr std::string_view kBenchmarkExplanation =
     "including it, without the hierarchy's build. Design points of different meshes (a "
     "resolution sweep) are each measured against their own reference, and each has its own "
     "Pareto front: the levels that no other level of the point beats in both time and error. "
-    "The reference itself has error 0, which the log-scale plot cannot draw; the table lists it.";
+    "The reference itself has error 0, which the log-scale plot cannot draw: its time is in the "
+    "legend entry of its front, and the table lists it.";
 
 /// The hierarchy cache in one sentence: hits, builds, their seconds and the time the hits saved
 /// (docs/reports.md).
