@@ -22,14 +22,17 @@ std::string quoted(const std::string& text) {
   return "'" + one_line_escaped(text, '\'', "''") + "'";
 }
 
-const char* style_name(PlotSpec::Style style) {
+std::string style_name(PlotSpec::Style style, int marker) {
+  const int point_type = marker > 0 ? marker : 7;
   switch (style) {
     case PlotSpec::Style::lines:
       return "lines lw 1.5";
     case PlotSpec::Style::points:
-      return "points pt 7 ps 0.8";
+      return fmt::format("points pt {} ps 0.8", point_type);
     case PlotSpec::Style::linespoints:
-      return "linespoints lw 1.5 pt 7 ps 0.6";
+      return fmt::format("linespoints lw 1.5 pt {} ps 0.6", point_type);
+    case PlotSpec::Style::thick_linespoints:
+      return fmt::format("linespoints lw 3 dt 2 pt {} ps 1.2", point_type);
   }
   return "linespoints";
 }
@@ -56,7 +59,9 @@ bool has_drawable_points(const PlotSpec& plot) {
 
 std::string gnuplot_script(const PlotSpec& plot, const std::filesystem::path& output) {
   std::string script;
-  script += "set terminal svg size 640,400 font 'Sans,11' background rgb 'white' noenhanced\n";
+  script +=
+      fmt::format("set terminal svg size 640,{} font 'Sans,11' background rgb 'white' noenhanced\n",
+                  plot.height);
   script += fmt::format("set output {}\n", quoted(output.string()));
   script += fmt::format("set title {}\n", quoted(plot.title));
   script +=
@@ -77,10 +82,11 @@ std::string gnuplot_script(const PlotSpec& plot, const std::filesystem::path& ou
     if (block.empty()) continue;
     script += fmt::format("$series{} << EOD\n{}EOD\n", s, block);
     const PlotSeries& series = plot.series[s];
-    clauses.push_back(fmt::format(
-        "$series{} using 1:2 with {}{} {}", s, style_name(plot.style),
-        series.colour.empty() ? "" : fmt::format(" lc rgb {}", quoted(series.colour)),
-        series.title.empty() ? "notitle" : "title " + quoted(series.title)));
+    clauses.push_back(
+        fmt::format("$series{} using 1:2 with {}{} {}", s,
+                    style_name(series.style.value_or(plot.style), series.marker),
+                    series.colour.empty() ? "" : fmt::format(" lc rgb {}", quoted(series.colour)),
+                    series.title.empty() ? "notitle" : "title " + quoted(series.title)));
   }
   script += "plot ";
   for (std::size_t c = 0; c < clauses.size(); ++c) script += (c ? ", \\\n     " : "") + clauses[c];

@@ -2,31 +2,41 @@
 // Plots drawn by gnuplot (a child process running a script file) as SVG text.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace psq::reports {
 
+/// How a curve is drawn; `thick_linespoints` (thick, dashed, large markers) stands out over
+/// the others: a Pareto front over the points it selects.
+enum class PlotStyle { lines, points, linespoints, thick_linespoints };
+
 /// One curve: its legend title (empty: not in the legend) and its (x, y) points in drawing
 /// order; `colour` ("#rrggbb") overrides gnuplot's colour sequence, so that several curves can
-/// read as one group.
+/// read as one group; `style` overrides the plot's style for this curve, and `marker` its point
+/// marker (gnuplot's point type; 0: a filled circle), so that curves of one colour can still be
+/// told apart.
 struct PlotSeries {
   std::string title;
   std::vector<std::pair<double, double>> points;
   std::string colour;
+  std::optional<PlotStyle> style = std::nullopt;
+  int marker = 0;
 };
 
 /// A 2D plot. On a logarithmic axis, points with a non-positive coordinate are left out;
 /// non-finite points are always left out.
 struct PlotSpec {
-  enum class Style { lines, points, linespoints };
+  using Style = PlotStyle;
   std::string title;
   std::string x_label;
   std::string y_label;
   bool log_x = false;
   bool log_y = false;
   bool integer_x = false;  ///< x tics on whole numbers only (levels, job numbers)
+  int height = 400;        ///< pixels, legend included (the legend goes below the plot)
   Style style = Style::linespoints;
   std::vector<PlotSeries> series;
 };

@@ -81,8 +81,9 @@ class PlotFigures {
 
 /// Where each plot of the page is in its PlotFigures.
 struct PagePlots {
-  std::vector<std::size_t> cost;   ///< time per level, error against run time
-  std::vector<std::size_t> sweep;  ///< outputs against the axis parameter
+  std::vector<std::size_t> cost;       ///< time per level, error against run time
+  std::vector<std::size_t> benchmark;  ///< per scene, error to direct_final against run time
+  std::vector<std::size_t> sweep;      ///< outputs against the axis parameter
   std::map<int, std::vector<std::size_t>> convergence;  ///< by job number, one per level
   std::map<int, std::vector<std::size_t>> probes;  ///< by job number, one per probe
 };
@@ -91,6 +92,8 @@ PagePlots collect_plots(const SweepReport& report, PlotFigures& plots) {
   PagePlots page;
   for (PlotSpec& plot : std::vector{time_per_level_plot(report), error_against_time_plot(report)})
     if (has_drawable_points(plot)) page.cost.push_back(plots.add(std::move(plot)));
+  for (PlotSpec& plot : benchmark_plots(report))
+    page.benchmark.push_back(plots.add(std::move(plot)));
   for (PlotSpec& plot : sweep_plots(report)) page.sweep.push_back(plots.add(std::move(plot)));
   for (const JobReport& job : report.jobs)
     if (job.finished()) {
@@ -244,6 +247,10 @@ std::string html_report(const SweepReport& report, Gnuplot& gnuplot) {
                         preview_gallery(report));
   if (const Table speedups = speedup_table(report); !speedups.rows.empty())
     body += "<h2>Speed-ups over the direct solves</h2>\n" + html_table(speedups);
+  if (const Table benchmark = benchmark_table(report); !benchmark.rows.empty())
+    body += fmt::format("<h2>Run time against error</h2>\n<p>{}</p>\n{}{}",
+                        escape_html(kBenchmarkExplanation),
+                        figure_row(plots.figures(page.benchmark)), html_table(benchmark));
   body += "<h2>Levels</h2>\n" + html_table(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     body += "<h2>Refinements</h2>\n" + html_table(refinements);

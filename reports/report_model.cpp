@@ -132,9 +132,10 @@ LevelShape level_shape(LevelCheckpoint& level, JobReport& job) {
   return {{std::move(whole)}};
 }
 
-/// Outputs of a finished job from its finest checkpoint, and every level's error to it.
+/// Outputs of a finished job from its finest checkpoint, and every level's error to it and to
+/// `reference` (the finest positions of the design point's reference, if there is one).
 void add_finest_results(const std::vector<std::optional<LevelCheckpoint>>& checkpoints,
-                        JobReport& job) {
+                        const Positions* reference, JobReport& job) {
   if (!checkpoints.back()) return;
   const Checkpoint& finest = checkpoints.back()->checkpoint;
   // The executor measures the answer on the finest mesh, where a coarse-prolonged job's
@@ -153,13 +154,23 @@ void add_finest_results(const std::vector<std::optional<LevelCheckpoint>>& check
   if (const auto energy = finest.solver.scalars.find(kElasticEnergyScalar);
       energy != finest.solver.scalars.end())
     job.outputs.elastic_energy = energy->second;
+  // Against the answer on the finest mesh: a coarse-prolonged job's positions are its coarse
+  // mesh's.
   for (std::size_t l = 0; l < checkpoints.size(); ++l) {
     if (!checkpoints[l]) continue;
     try {
-      job.levels[l].error_to_finest =
-          relative_error_to_finest(checkpoints[l]->checkpoint.finest_positions, finest.positions);
+      job.levels[l].error_to_finest = relative_error_to_finest(
+          checkpoints[l]->checkpoint.finest_positions, finest.finest_positions);
     } catch (const std::invalid_argument& e) {
       job.problems.push_back(fmt::format("level {}: error to the finest level: {}", l, e.what()));
+    }
+    if (!reference) continue;
+    try {
+      job.levels[l].error_to_reference =
+          relative_error_to_finest(checkpoints[l]->checkpoint.finest_positions, *reference);
+    } catch (const std::invalid_argument& e) {
+      job.problems.push_back(
+          fmt::format("level {}: error to the direct_final reference: {}", l, e.what()));
     }
   }
 }
@@ -173,17 +184,8 @@ void add_level_pictures(std::vector<std::optional<LevelCheckpoint>>& checkpoints
   }
 }
 
-std::optional<double> total_seconds(const std::vector<LevelReport>& levels) {
-  double total = 0.0;
-  for (const LevelReport& level : levels) {
-    if (!level.seconds) return std::nullopt;
-    total += *level.seconds;
-  }
-  return total;
-}
-
-JobReport job_report(const db::JobResult& result, int number,
-                     const std::filesystem::path& database) {
+JobReport job_report(const db::JobResult& result, int number, const std::filesystem::path& database,
+                     const Positions* reference) {
   JobReport job;
   job.number = number;
   job.job = result.job;
@@ -197,14 +199,49 @@ JobReport job_report(const db::JobResult& result, int number,
   std::vector<std::optional<LevelCheckpoint>> checkpoints =
       read_level_checkpoints(result, database, shown, job);
   if (job.finished()) {
-    job.outputs.total_seconds = total_seconds(job.levels);
-    add_finest_results(checkpoints, job);
+    job.outputs.total_seconds = job.seconds_through(job.levels.size() - 1);
+    add_finest_results(checkpoints, reference, job);
   }
   add_level_pictures(checkpoints, job);
   return job;
 }
 
+/// The finest positions of each design point's reference: its finished direct_final job's
+/// checkpoint. An unreadable one is left out here; that job's own report names the problem.
+std::map<std::string, Positions> reference_positions(const std::vector<db::JobResult>& results,
+                                                     const std::filesystem::path& database) {
+  std::map<std::string, Positions> references;
+  for (const db::JobResult& result : results) {
+    if (result.job.method != db::Method::direct_final || result.job.state != db::JobState::done ||
+        result.levels.empty() || result.levels.back().checkpoint_path.empty())
+      continue;
+    const db::LevelRecord& record = result.levels.back();
+    const std::filesystem::path file = resolve_checkpoint(record.checkpoint_path, database);
+    try {
+      references.emplace(design_point(result.job),
+                         read_checkpoint(file, recorded_checksum(record.checkpoint_checksum, file))
+                             .finest_positions);
+    } catch (const InputError&) {
+    }
+  }
+  return references;
+}
+
 }  // namespace
+
+std::string design_point(const db::Job& job) {
+  return job.parameters.value("scene", "") +
+         job.parameters.value("overrides", nlohmann::json::object()).dump();
+}
+
+std::optional<double> JobReport::seconds_through(std::size_t level) const {
+  double elapsed = 0.0;
+  for (std::size_t l = 0; l <= level && l < levels.size(); ++l) {
+    if (!levels[l].seconds) return std::nullopt;
+    elapsed += *levels[l].seconds;
+  }
+  return elapsed;
+}
 
 std::vector<NewtonSolve> newton_solves(const std::vector<IterationRecord>& iterations) {
   std::vector<NewtonSolve> solves;
@@ -269,8 +306,11 @@ SweepReport gather_sweep_report(db::JobStore& store, const std::string& sweep) {
   std::vector<std::map<std::string, nlohmann::json>> parameter_sets;
   std::set<std::string> names;
   std::vector<db::HierarchyCacheUse> cache_uses;
+  const std::map<std::string, Positions> references = reference_positions(results, report.database);
   for (std::size_t i = 0; i < results.size(); ++i) {
-    report.jobs.push_back(job_report(results[i], static_cast<int>(i) + 1, report.database));
+    const auto reference = references.find(design_point(results[i].job));
+    report.jobs.push_back(job_report(results[i], static_cast<int>(i) + 1, report.database,
+                                     reference == references.end() ? nullptr : &reference->second));
     parameter_sets.push_back(report.jobs.back().parameters);
     for (const auto& [name, value] : report.jobs.back().parameters) names.insert(name);
     report.max_depth = std::max(report.max_depth, results[i].job.depth);

@@ -53,6 +53,10 @@ struct LevelReport {
   /// max_i ‖P(x_l)_i − x_L,i‖ / diag(x_L): this level's state prolonged to the finest mesh
   /// against the finest level's converged state, relative to the latter's bounding box.
   std::optional<double> error_to_finest;
+  /// The same measure against the reference of the job's design point (the finished
+  /// direct_final job of the same scene and overrides, see design_point), instead of this job's
+  /// own finest level: the error the benchmark plot and table show. Empty without a reference.
+  std::optional<double> error_to_reference;
   /// What the refinement into this level did, by name, as stored (engine/progressive/
   /// refinement_statistics.hpp); empty at level 0 and for a direct solve.
   std::map<std::string, double> refinement;
@@ -80,6 +84,11 @@ struct JobOutputs {
 /// refine frame", "progressive, N levels" or "coarse of N levels, prolonged".
 std::string method_label(const db::Job& job);
 
+/// What makes jobs the same design point whatever their method and depth: their scene and
+/// overrides. Jobs of one design point solve the same problem on the same finest mesh, so their
+/// positions can be compared vertex by vertex.
+std::string design_point(const db::Job& job);
+
 /// One job of the sweep.
 struct JobReport {
   int number = 0;  ///< 1-based position in the sweep: the label used in plots and tables
@@ -92,6 +101,8 @@ struct JobReport {
   std::vector<std::string> problems;
 
   bool finished() const { return job.state == db::JobState::done; }
+  /// The wall time of its levels 0..`level`, when each of them has timings.
+  std::optional<double> seconds_through(std::size_t level) const;
   bool previewed() const { return job.state == db::JobState::previewed; }
 };
 
@@ -134,7 +145,9 @@ struct SweepReport {
   HierarchyCacheSummary hierarchy_cache;
 };
 
-/// Reads the sweep `sweep` from `store` and every checkpoint its finished jobs recorded.
+/// Reads the sweep `sweep` from `store` and every checkpoint its finished jobs recorded, and
+/// measures every level of a finished job against its design point's reference (the
+/// finished direct_final job there, if any: LevelReport::error_to_reference).
 /// Relative checkpoint paths are resolved against the store's directory (the workspace),
 /// then against the current directory. A missing, damaged or inconsistent checkpoint becomes
 /// a problem of its job. Throws InputError for an unknown sweep.

@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <set>
 
+#include "reports/benchmark.hpp"
 #include "reports/parameters.hpp"
+#include "reports/report_tables.hpp"
 #include "reports/shape_picture.hpp"
 
 namespace psq::reports {
@@ -267,15 +270,79 @@ PlotSpec error_against_time_plot(const SweepReport& report) {
   for (const JobReport& job : report.jobs) {
     if (!job.finished()) continue;
     PlotSeries series{fmt::format("{} ({})", job_label(job), method_label(job.job)), {}, {}};
-    double elapsed = 0.0;
-    for (const LevelReport& level : job.levels) {
-      if (!level.seconds) break;
-      elapsed += *level.seconds;
-      if (level.error_to_finest) series.points.emplace_back(elapsed, *level.error_to_finest);
+    for (std::size_t l = 0; l < job.levels.size(); ++l) {
+      const std::optional<double> elapsed = job.seconds_through(l);
+      if (!elapsed) break;
+      if (const std::optional<double> error = job.levels[l].error_to_finest)
+        series.points.emplace_back(*elapsed, *error);
     }
     plot.series.push_back(std::move(series));
   }
   return plot;
+}
+
+std::vector<PlotSpec> benchmark_plots(const SweepReport& report) {
+  // A colour per method and a marker per design point: a legend entry per job would crowd out
+  // the plot of a methods × depth × resolution sweep; the table lists every job.
+  static const std::array<const char*, 8> kMethodColours{
+      "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"};
+  static const std::array<int, 5> kMarkers{7, 5, 9, 13, 11};  // filled ● ■ ▲ ◆ ▼
+  constexpr int kPlotHeight = 330, kLegendLineHeight = 20;    // pixels
+  std::vector<PlotSpec> plots;
+  for (const BenchmarkScene& scene : benchmark_scenes(report)) {
+    const bool several = scene.design_points.size() > 1;
+    PlotSpec plot;
+    plot.title = fmt::format("{}: error to direct_final{} against run time",
+                             std::filesystem::path(scene.scene).stem().string(),
+                             several ? " of the same mesh and parameters," : "");
+    plot.x_label = "run time up to the level (s)";
+    plot.y_label = "max vertex error / bounding box diagonal";
+    plot.log_x = true;
+    plot.log_y = true;
+    std::vector<std::string> methods;  // in order of first appearance: their colours
+    std::size_t legend_lines = 0;
+    for (std::size_t d = 0; d < scene.design_points.size(); ++d) {
+      const BenchmarkDesignPoint& design = scene.design_points[d];
+      const int marker = kMarkers[d % kMarkers.size()];
+      // The reference ends every front, but its error, 0, has no place on a log scale: its
+      // time goes in the legend instead.
+      const std::string reference = fmt::format(
+          "direct_final {} s", readable_number(design.reference->outputs.total_seconds));
+      PlotSeries front{several ? fmt::format("Pareto front, {} ({})", design.label, reference)
+                               : fmt::format("Pareto front ({})", reference),
+                       {},
+                       "#000000",
+                       PlotStyle::thick_linespoints,
+                       marker};
+      std::map<const JobReport*, std::size_t> curve_of_job;
+      for (const BenchmarkPoint& point : design.points) {
+        if (point.on_front) front.points.emplace_back(point.seconds, point.error);
+        // The reference's error is 0, which a log scale cannot draw.
+        if (point.job == design.reference) continue;
+        const auto [curve, added] = curve_of_job.try_emplace(point.job, plot.series.size());
+        if (added) {
+          const std::string method = method_label(point.job->job);
+          auto known = std::find(methods.begin(), methods.end(), method);
+          const bool first = known == methods.end();
+          if (first) known = methods.insert(methods.end(), method);
+          legend_lines += first;
+          plot.series.push_back({first ? method : std::string(),
+                                 {},
+                                 kMethodColours[static_cast<std::size_t>(known - methods.begin()) %
+                                                kMethodColours.size()],
+                                 std::nullopt,
+                                 marker});
+        }
+        plot.series[curve->second].points.emplace_back(point.seconds, point.error);
+      }
+      std::sort(front.points.begin(), front.points.end());
+      plot.series.push_back(std::move(front));
+      ++legend_lines;
+    }
+    plot.height = kPlotHeight + kLegendLineHeight * static_cast<int>(legend_lines);
+    if (has_drawable_points(plot)) plots.push_back(std::move(plot));
+  }
+  return plots;
 }
 
 std::vector<PlotSpec> sweep_plots(const SweepReport& report) {

@@ -30,6 +30,16 @@ PlotSpec time_per_level_plot(const SweepReport& report);
 /// is 0 and cannot be drawn on a log scale.
 PlotSpec error_against_time_plot(const SweepReport& report);
 
+/// Run time against error (benchmark_scenes), one plot per scene: every level of every
+/// finished job as a point (wall time up to the level, error to its design point's direct_final
+/// reference), log scales, one curve per job through its levels, coloured by its method (one
+/// legend entry per method) and marked by its design point, and each design point's Pareto
+/// front as a thick dashed black line with its marker through the points it selects. The
+/// reference's own point (error 0) cannot be drawn on a log scale: its time is in its front's
+/// legend entry, and the benchmark table lists it. With several design points (a resolution sweep),
+/// each is measured against its own reference, which the title says.
+std::vector<PlotSpec> benchmark_plots(const SweepReport& report);
+
 /// One plot per job output (max displacement, elastic energy, time) against the sweep's axis
 /// parameter: the numeric swept parameter with the most distinct values among finished jobs.
 /// One curve per combination of the swept parameters that vary independently of the axis;

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <array>
-#include <iterator>
 
+#include "reports/benchmark.hpp"
 #include "reports/html_text.hpp"
 #include "reports/parameters.hpp"
 
@@ -39,19 +39,10 @@ std::optional<double> level_output(const JobReport& job, int level, const std::s
   return found->second;
 }
 
-/// What makes jobs the same design point whatever their method: their scene and overrides.
-std::string design_point(const db::Job& job) {
-  return job.parameters.value("scene", "") +
-         job.parameters.value("overrides", nlohmann::json::object()).dump();
-}
-
-/// The finished job of `method` at `job`'s design point, if the sweep has one.
-const JobReport* baseline_of(const SweepReport& report, const JobReport& job, db::Method method) {
-  for (const JobReport& other : report.jobs)
-    if (other.finished() && other.job.method == method &&
-        design_point(other.job) == design_point(job.job))
-      return &other;
-  return nullptr;
+/// `baseline` over `seconds`, when both are known and `seconds` is positive.
+std::optional<double> speedup(std::optional<double> baseline, double seconds) {
+  if (!baseline || !(seconds > 0)) return std::nullopt;
+  return *baseline / seconds;
 }
 
 }  // namespace
@@ -204,10 +195,7 @@ Table refinements_table(const SweepReport& report) {
 
 Table speedup_table(const SweepReport& report) {
   // The method column names the depth and the method: the other swept parameters give the point.
-  std::vector<std::string> point_parameters;
-  std::copy_if(report.swept_parameters.begin(), report.swept_parameters.end(),
-               std::back_inserter(point_parameters),
-               [](const std::string& name) { return name != "depth" && name != "method"; });
+  const std::vector<std::string> point_parameters = design_parameters(report);
   Table table;
   table.header = {"#", "id"};
   table.header.insert(table.header.end(), point_parameters.begin(), point_parameters.end());
@@ -229,12 +217,39 @@ Table speedup_table(const SweepReport& report) {
       const std::optional<double> seconds =
           baseline ? baseline->outputs.total_seconds : std::nullopt;
       row.push_back(readable_number(seconds));
-      row.push_back(readable_number(seconds && *job.outputs.total_seconds > 0
-                                        ? std::optional(*seconds / *job.outputs.total_seconds)
-                                        : std::nullopt));
+      row.push_back(readable_number(speedup(seconds, *job.outputs.total_seconds)));
     }
     table.rows.push_back(std::move(row));
   }
+  return table;
+}
+
+Table benchmark_table(const SweepReport& report) {
+  const std::vector<std::string> point_parameters = design_parameters(report);
+  Table table;
+  table.header = {"#", "id"};
+  table.header.insert(table.header.end(), point_parameters.begin(), point_parameters.end());
+  for (const char* column : {"method", "level", "time (s)", "error to direct_final",
+                             "speed-up over direct_final", "speed-up over direct", "Pareto front"})
+    table.header.push_back(column);
+  for (const BenchmarkScene& scene : benchmark_scenes(report))
+    for (const BenchmarkDesignPoint& design : scene.design_points) {
+      const JobReport* direct = baseline_of(report, *design.reference, db::Method::direct);
+      for (const BenchmarkPoint& point : design.points) {
+        const JobReport& job = *point.job;
+        std::vector<std::string> row = {std::to_string(job.number), job.job.id.substr(0, 8)};
+        for (const std::string& name : point_parameters) row.push_back(parameter_cell(job, name));
+        row.insert(
+            row.end(),
+            {method_label(job.job), fmt::format("{} of {}", point.level, job.levels.size()),
+             readable_number(point.seconds), readable_number(point.error),
+             readable_number(speedup(design.reference->outputs.total_seconds, point.seconds)),
+             readable_number(
+                 speedup(direct ? direct->outputs.total_seconds : std::nullopt, point.seconds)),
+             point.on_front ? "yes" : ""});
+        table.rows.push_back(std::move(row));
+      }
+    }
   return table;
 }
 

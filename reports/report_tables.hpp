@@ -3,6 +3,7 @@
 // Markdown or HTML.
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "reports/report_model.hpp"
@@ -48,6 +49,27 @@ Table preview_table(const SweepReport& report);
 /// speed-up (baseline time over the job's); empty cells where that baseline is missing. No rows
 /// when the sweep has no such pair.
 Table speedup_table(const SweepReport& report);
+
+/// Run time against error (benchmark_scenes): one row per level of every finished job of a
+/// design point with a direct_final reference, the reference's own included — number, short id,
+/// design parameters, method, level ("l of L"), the wall time up to the level, its error to the
+/// reference, the speed-ups over the reference and over the design point's `direct` job (its
+/// time over the level's), and "yes" when the level is on its design point's Pareto front. No
+/// rows when the sweep has no reference with another job beside it.
+Table benchmark_table(const SweepReport& report);
+
+/// What the benchmark plot and table measure, for the text above them.
+inline constexpr std::string_view kBenchmarkExplanation =
+    "Every level of every finished job against the reference of its design point: the "
+    "direct_final job of the same scene and overrides (the same mesh), the finest direct solve "
+    "settled to equilibrium from the refine frame on. Error: the largest distance of a vertex of "
+    "the level's answer, prolonged to the finest mesh, from the reference's, over the diagonal "
+    "of the reference's bounding box; time: the wall time of the job's levels up to and "
+    "including it, without the hierarchy's build. Design points of different meshes (a "
+    "resolution sweep) are each measured against their own reference, and each has its own "
+    "Pareto front: the levels that no other level of the point beats in both time and error. "
+    "The reference itself has error 0, which the log-scale plot cannot draw: its time is in the "
+    "legend entry of its front, and the table lists it.";
 
 /// The hierarchy cache in one sentence: hits, builds, their seconds and the time the hits saved
 /// (docs/reports.md).

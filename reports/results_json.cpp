@@ -36,6 +36,7 @@ nlohmann::json level_json(const LevelReport& level) {
           {"static_residual", number_or_null(level.static_residual)},
           {"static_residuals", static_residuals},
           {"error_to_finest", number_or_null(level.error_to_finest)},
+          {"error_to_reference", number_or_null(level.error_to_reference)},
           {"refinement", level.refinement},
           {"frames", frames_json(level.frames)},
           {"checkpoint", level.checkpoint},

@@ -13,7 +13,8 @@ namespace psq::reports {
 ///  "jobs": [{"number", "id", "parameters" (as stored), "flat_parameters", "state", "attempts",
 ///  "failures", "error", "outputs": {"total_seconds", "max_displacement", "elastic_energy"},
 ///  "problems": [...], "levels": [{"level", "status", "iterations", "seconds", "timings",
-///  "final_residual", "error_to_finest", "checkpoint", "error", "residuals": [...]}]}]}.
+///  "final_residual", "error_to_finest", "error_to_reference", "checkpoint", "error",
+///  "residuals": [...]}]}]}.
 /// Values that are not known, and non-finite residuals, are null.
 nlohmann::json results_json(const SweepReport& report);
 

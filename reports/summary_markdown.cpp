@@ -20,6 +20,9 @@ std::string summary_markdown(const SweepReport& report) {
                         to_markdown(previews));
   if (const Table speedups = speedup_table(report); !speedups.rows.empty())
     text += "\n## Speed-ups over the direct solves\n\n" + to_markdown(speedups);
+  if (const Table benchmark = benchmark_table(report); !benchmark.rows.empty())
+    text += fmt::format("\n## Run time against error\n\n{}\n\n{}", kBenchmarkExplanation,
+                        to_markdown(benchmark));
   text += "\n## Levels\n\n" + to_markdown(levels_table(report));
   if (const Table refinements = refinements_table(report); !refinements.rows.empty())
     text += "\n## Refinements\n\n" + to_markdown(refinements);
