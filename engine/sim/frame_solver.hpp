@@ -10,10 +10,11 @@
 // targets: with contact, κ is chosen first (IPC), then they move directly when the CCD finds
 // that move safe; otherwise they are freed and pulled toward the targets by a penalty of
 // growing stiffness (KinematicPull) while the CCD line search keeps every iterate
-// intersection-free, and they are pinned at the targets as soon as the rest of the way is safe. The step's solve (solve_held)
-// follows with them fixed: Newton in chunks with κ and κ_s adapted between chunks, inside IPC's
-// outer friction loop when the scene has friction. With strain limits, the line search starts
-// from the barrier's feasible step, so no accepted iterate stretches a triangle to its limit.
+// intersection-free, and they are pinned at the targets as soon as the rest of the way is safe.
+// The step's solve (solve_held) follows with them fixed: Newton in chunks with κ and κ_s adapted
+// between chunks, inside IPC's outer friction loop when the scene has friction. With strain
+// limits, the line search starts from the barrier's feasible step, so no accepted iterate
+// stretches a triangle to its limit.
 
 #include <limits>
 #include <map>

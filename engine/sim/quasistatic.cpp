@@ -95,7 +95,8 @@ FrameRecord QuasistaticSimulation::step(const Progress& progress) {
   // settled frame's last step barely moved, so its prediction is nil. The motion is x − xᵗ,
   // which a snapshot between frames holds, so a resumed run predicts as the uninterrupted one.
   const bool fresh_frame = resumed_iterations == 0;
-  const Eigen::VectorXd last_motion = fresh_frame ? Eigen::VectorXd(x_ - previous_) : Eigen::VectorXd();
+  const Eigen::VectorXd last_motion =
+      fresh_frame ? Eigen::VectorXd(x_ - previous_) : Eigen::VectorXd();
   if (fresh_frame) previous_ = x_;
   frame_start_ = previous_;
   potential_.set_previous(previous_);
