@@ -31,6 +31,11 @@ constexpr std::string_view hdf5_signature = "\x89HDF\r\n\x1a\n";
   throw CheckpointError(located_message(file, 0, std::string(problem)));
 }
 
+/// The same for a consistent checkpoint that the file system would not take.
+[[noreturn]] void fail_to_write(const std::string& file, std::string_view problem) {
+  throw CheckpointWriteError(located_message(file, 0, std::string(problem)));
+}
+
 constexpr std::array progress_names{std::pair{LevelProgress::inside_frame, "inside_frame"},
                                     std::pair{LevelProgress::frame_done, "frame_done"},
                                     std::pair{LevelProgress::level_done, "level_done"}};
@@ -313,9 +318,8 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
     fail(file_name, fmt::format("refusing to write an inconsistent checkpoint: {}", *problem));
   const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
   if (std::error_code error; !std::filesystem::is_directory(directory, error))
-    throw CheckpointWriteError(located_message(
-        file_name, 0,
-        fmt::format("cannot write checkpoint: no directory '{}'", directory.string())));
+    fail_to_write(file_name,
+                  fmt::format("cannot write checkpoint: no directory '{}'", directory.string()));
   try {
     std::uint64_t checksum = 0;
     replace_file_atomically(path, [&](const std::filesystem::path& temporary) {
@@ -331,8 +335,7 @@ std::uint64_t write_checkpoint(const std::filesystem::path& path, const Checkpoi
     return checksum;
   } catch (const std::exception& e) {
     // HDF5 errors name the temporary file; the caller knows the checkpoint by its final name.
-    throw CheckpointWriteError(
-        located_message(file_name, 0, fmt::format("cannot write checkpoint: {}", e.what())));
+    fail_to_write(file_name, fmt::format("cannot write checkpoint: {}", e.what()));
   }
 }
 
